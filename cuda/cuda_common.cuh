@@ -1,0 +1,44 @@
+#pragma once
+#include <cuda_runtime.h>
+
+#include <stdexcept>
+#include <string>
+
+#define PP_CUDA_CHECK(call)                                                                   \
+  do {                                                                                        \
+    const cudaError_t pp_err = (call);                                                        \
+    if (pp_err != cudaSuccess)                                                                \
+      throw std::runtime_error(std::string("CUDA error in ") + #call + ": " +                 \
+                               cudaGetErrorString(pp_err));                                   \
+  } while (0)
+
+namespace place_planner {
+namespace cuda {
+
+// RAII device buffer.
+template <typename T>
+class DeviceBuffer {
+ public:
+  explicit DeviceBuffer(size_t n) : n_(n) {
+    if (n_) PP_CUDA_CHECK(cudaMalloc(&ptr_, n_ * sizeof(T)));
+  }
+  ~DeviceBuffer() {
+    if (ptr_) cudaFree(ptr_);
+  }
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  T* get() const { return ptr_; }
+  void upload(const T* h) { if (n_) PP_CUDA_CHECK(cudaMemcpy(ptr_, h, n_ * sizeof(T), cudaMemcpyHostToDevice)); }
+  void download(T* h) const { if (n_) PP_CUDA_CHECK(cudaMemcpy(h, ptr_, n_ * sizeof(T), cudaMemcpyDeviceToHost)); }
+
+ private:
+  T* ptr_ = nullptr;
+  size_t n_;
+};
+
+inline unsigned blocksFor(size_t n, unsigned threads = 256) {
+  return static_cast<unsigned>((n + threads - 1) / threads);
+}
+
+}  // namespace cuda
+}  // namespace place_planner

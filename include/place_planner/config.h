@@ -1,0 +1,49 @@
+// Planner parameters: one plain struct, the default beside each field (voxblox style).
+// config/place_planner.yaml mirrors it field for field; validate() names a bad field.
+#pragma once
+#include <Eigen/Core>
+#include <string>
+
+namespace place_planner {
+
+enum class OrientationMode {
+  kPrincipalAxis,  // Section IV-A: k1 of the object parallel to the approach direction
+  kKeep,           // keep the orientation the object is given in
+  kAllAxes,        // try +-k1, +-k2, +-k3 along the approach direction
+};
+
+enum class BackendKind { kAuto, kCpu, kCuda };
+
+struct PlannerConfig {
+  Eigen::Vector3d gravity{0.0, 0.0, -1.0};   // d_g, normalised by the planner
+  Eigen::Vector3d approach{0.0, 0.0, 0.0};   // d_vis; zero = gravity (Section VII)
+  double friction = 0.2;                     // mu (Section VII)
+  double floor_point_spacing = 0.09;         // m, grid of rays (Section VII-B)
+  int min_floor_points = 16;                 // spacing is refined until this many are tried
+  int lowest_n = 0;                          // box-like areas: keep the n lowest (0 = all)
+  int max_rotations = 5;                     // depth of the rotation tree (Section VII-C)
+  double sphere_radius = 0.0;                // m, surface sphere model; 0 = derived from sizes
+  double grid_cell_size = 0.0;               // m, 2D height grid; 0 = derived from sphere radius
+  OrientationMode orientation = OrientationMode::kPrincipalAxis;
+  double time_budget_ms = 0.0;               // 0 = no budget
+  int max_candidates = 10;                   // after ranking and merging
+  int threads = 0;                           // 0 = all hardware threads
+  int max_local_optimisation_steps = 4;      // slides/rotations per leaf (Section VI)
+  double min_quality = 0.0;                  // candidates below are dropped
+  double merge_distance = 0.005;             // m, poses closer than this ...
+  double merge_angle_deg = 3.0;              // ... and this are one candidate
+  BackendKind backend = BackendKind::kAuto;  // kAuto: CUDA when a GPU is usable, else CPU
+  // Optional region (planning frame) the floor points must lie in; inactive when min > max.
+  Eigen::Vector3d region_min{1.0, 1.0, 1.0};
+  Eigen::Vector3d region_max{-1.0, -1.0, -1.0};
+  bool hasRegion() const { return (region_min.array() <= region_max.array()).all(); }
+};
+
+// Throws std::invalid_argument naming the first out-of-range field, e.g.
+// "friction = -0.1 is out of range (must be >= 0)".
+void validate(const PlannerConfig& config);
+
+OrientationMode orientationModeFromString(const std::string& s);  // throws on an unknown name
+std::string toString(OrientationMode m);
+
+}  // namespace place_planner

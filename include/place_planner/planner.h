@@ -1,0 +1,76 @@
+// The placement planner (the paper's Sections IV-VI): floor points, pre-orientation, first
+// contact, contact points, tilt axis and exact tilt angles in a binary tree of rotations,
+// stability, local optimisation and quality, batched over all pending poses.
+// Frames: W is the planning frame of the placement area mesh, O the object mesh's own frame.
+#pragma once
+#include <Eigen/Geometry>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "place_planner/config.h"
+#include "place_planner/mesh.h"
+
+namespace place_planner {
+
+struct ContactPoint {
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  // position
+  Eigen::Vector3d n_W = Eigen::Vector3d::UnitZ(); // unit normal, pointing at the object
+};
+
+struct Candidate {
+  Eigen::Isometry3d X_WO = Eigen::Isometry3d::Identity();  // goal pose of the object mesh frame
+  double quality = 0.0;                                     // Q (Section VI), <= 1
+  bool stable = false;
+  std::vector<ContactPoint> contacts;                       // at the goal pose
+  Eigen::Vector3d floor_point_W = Eigen::Vector3d::Zero();
+  // Ordered: pre-placement pose above the floor point first, one per translation or rotation,
+  // the goal pose last.
+  std::vector<Eigen::Isometry3d> intermediate_poses;
+};
+
+struct StepTimes {  // wall time per batched step, ms
+  double floor_points = 0, first_contact = 0, contact_points = 0, tilt_vertex = 0, tilt_edge = 0,
+         stability = 0, local_optimisation = 0;
+};
+
+struct PlanStats {
+  int floor_points_total = 0;
+  int floor_points_done = 0;
+  long tree_nodes = 0;             // poses evaluated over all trees
+  double first_stable_ms = -1.0;   // -1: none found
+  double total_ms = 0.0;
+  StepTimes steps;
+  std::string backend;             // "cpu" or "cuda"
+  double sphere_radius = 0.0;      // as used (derived when the config says 0)
+};
+
+struct PlanResult {
+  std::vector<Candidate> candidates;  // ranked: stable first, then by quality
+  std::vector<Eigen::Vector3d> floor_points_W;
+  PlanStats stats;
+  bool cancelled = false;
+  bool timed_out = false;
+};
+
+struct Progress {
+  int floor_points_done = 0;
+  int floor_points_total = 0;
+  double best_quality = 0.0;  // of stable candidates so far; 0 when none
+  int candidates = 0;
+  double elapsed_ms = 0.0;
+};
+
+// Called between batched steps (every few ms). Return false to cancel: plan() then returns the
+// candidates found so far with cancelled = true.
+using ProgressCallback = std::function<bool(const Progress&)>;
+
+class Planner {
+ public:
+  // object: M_O in its own frame O. area: M_P in the planning frame W.
+  // Throws std::invalid_argument for a bad config (naming the field).
+  PlanResult plan(const Mesh& object, const Mesh& area, const PlannerConfig& config,
+                  const ProgressCallback& progress = {}) const;
+};
+
+}  // namespace place_planner

@@ -1,0 +1,74 @@
+#include "place_planner/config.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace place_planner {
+namespace {
+
+template <typename T>
+void require(bool ok, const char* field, T value, const char* range) {
+  if (ok) return;
+  std::ostringstream os;
+  os << field << " = " << value << " is out of range (" << range << ")";
+  throw std::invalid_argument(os.str());
+}
+
+void requireVector(const Eigen::Vector3d& v, const char* field, bool allow_zero) {
+  const bool finite = v.allFinite();
+  const bool nonzero = v.norm() > 1e-9;
+  if (finite && (allow_zero || nonzero)) return;
+  std::ostringstream os;
+  os << field << " = (" << v.x() << ", " << v.y() << ", " << v.z() << ") is invalid ("
+     << (finite ? "must not be zero" : "must be finite") << ")";
+  throw std::invalid_argument(os.str());
+}
+
+}  // namespace
+
+void validate(const PlannerConfig& c) {
+  requireVector(c.gravity, "gravity", false);
+  requireVector(c.approach, "approach", true);
+  require(std::isfinite(c.friction) && c.friction >= 0 && c.friction <= 10, "friction", c.friction,
+          "0 <= friction <= 10");
+  require(std::isfinite(c.floor_point_spacing) && c.floor_point_spacing > 1e-4, "floor_point_spacing",
+          c.floor_point_spacing, "> 0.0001 m");
+  require(c.min_floor_points >= 1 && c.min_floor_points <= 100000, "min_floor_points",
+          c.min_floor_points, "1 .. 100000");
+  require(c.lowest_n >= 0, "lowest_n", c.lowest_n, ">= 0");
+  require(c.max_rotations >= 0 && c.max_rotations <= 12, "max_rotations", c.max_rotations, "0 .. 12");
+  require(std::isfinite(c.sphere_radius) && c.sphere_radius >= 0, "sphere_radius", c.sphere_radius,
+          ">= 0, 0 = derived");
+  require(std::isfinite(c.grid_cell_size) && c.grid_cell_size >= 0, "grid_cell_size",
+          c.grid_cell_size, ">= 0, 0 = derived");
+  require(std::isfinite(c.time_budget_ms) && c.time_budget_ms >= 0, "time_budget_ms",
+          c.time_budget_ms, ">= 0, 0 = none");
+  require(c.max_candidates >= 1, "max_candidates", c.max_candidates, ">= 1");
+  require(c.threads >= 0 && c.threads <= 256, "threads", c.threads, "0 .. 256, 0 = all");
+  require(c.max_local_optimisation_steps >= 0 && c.max_local_optimisation_steps <= 50,
+          "max_local_optimisation_steps", c.max_local_optimisation_steps, "0 .. 50");
+  require(std::isfinite(c.min_quality) && c.min_quality <= 1, "min_quality", c.min_quality, "<= 1");
+  require(std::isfinite(c.merge_distance) && c.merge_distance >= 0, "merge_distance",
+          c.merge_distance, ">= 0");
+  require(std::isfinite(c.merge_angle_deg) && c.merge_angle_deg >= 0, "merge_angle_deg",
+          c.merge_angle_deg, ">= 0");
+}
+
+OrientationMode orientationModeFromString(const std::string& s) {
+  if (s == "principal_axis" || s.empty()) return OrientationMode::kPrincipalAxis;
+  if (s == "keep") return OrientationMode::kKeep;
+  if (s == "all_axes") return OrientationMode::kAllAxes;
+  throw std::invalid_argument("orientation_mode = '" + s +
+                              "' is unknown (use principal_axis, keep or all_axes)");
+}
+
+std::string toString(OrientationMode m) {
+  switch (m) {
+    case OrientationMode::kKeep: return "keep";
+    case OrientationMode::kAllAxes: return "all_axes";
+    default: return "principal_axis";
+  }
+}
+
+}  // namespace place_planner

@@ -1,0 +1,107 @@
+// Physics check of placement poses with Bullet, and the paper's drop-and-settle baseline.
+// Frames: W is the frame of the placement area mesh (z up, gravity -z unless configured),
+// O the object mesh's own frame; X_WO is the pose of O in W, as in place_planner::Candidate.
+//
+// The header is Bullet-free (pimpl): only src/validation/*.cpp include Bullet.
+//
+// Model (settings measured on this machine, ../shared/ENVIRONMENT.md "Bullet"):
+//  - area: one static btBvhTriangleMeshShape of all area triangles, friction 1.0, margin `margin`
+//    (with the default margin 0 objects crept down slopes they should stick to);
+//  - object: a btCompoundShape of small btConvexHullShape pieces, each a group of neighbouring
+//    triangles of similar normal, thickened inwards by `piece_thickness` (a GImpact mesh
+//    jitters on a triangle mesh; small hulls rest still), margins `margin` (1 mm: 0.5 mm gave
+//    wrong static friction) and inset by the two margins so that the true surfaces touch (a cube
+//    on a table rests at its geometric height, not 2 mm above), friction mu (Bullet multiplies the two coefficients: mu x 1.0);
+//  - mass = density x bounding-box volume, centred on the mesh's centre of mass c_O (the same
+//    surface centroid the planner uses), inertia of the solid bounding box about c_O.
+#pragma once
+#include <Eigen/Geometry>
+#include <memory>
+
+#include "place_planner/mesh.h"
+
+namespace place_planner {
+namespace validation {
+
+struct ValidatorConfig {
+  double friction = 0.2;                 // mu of the object; the area gets 1.0 (product = mu)
+  double density = 400.0;                // kg/m^3 of the object's bounding box (household goods)
+  double time_step = 1.0 / 480.0;        // s, fixed step
+  int solver_iterations = 30;
+  double margin = 0.001;                 // m, convex hull margins (1 mm, see above)
+  double piece_thickness = 0.002;        // m, inward thickening of each surface piece
+  int piece_max_triangles = 12;          // triangles per convex piece at most
+  double piece_max_normal_deg = 40.0;    // piece triangles' normals within this of the seed's
+  double piece_max_size = 0.03;          // m, largest distance of a piece triangle from its seed
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2, world frame
+  // Stability check (issue 5): simulate `settle_time` from the goal pose, released `release_gap`
+  // above it (against gravity: a body started exactly in contact is pushed off by the margins);
+  // confirmed when the object's centre of mass moved less than `max_translation` and the object
+  // turned less than `max_rotation_deg`, both measured against the goal pose.
+  double settle_time = 2.0;              // s
+  double release_gap = 0.002;            // m
+  double max_translation = 0.01;         // m
+  double max_rotation_deg = 5.0;         // deg
+  // Once the object has moved this far the run stops early (it cannot come back within bounds).
+  double abort_translation = 0.05;       // m
+  double abort_rotation_deg = 30.0;      // deg
+  // Drop-and-settle (the paper's baseline): step until linear speed < rest_linear and angular
+  // speed < rest_angular for rest_steps consecutive steps; give up after max_drop_time, or once
+  // the object is `fall_below` under the lowest point of the area (it fell off).
+  double rest_linear = 0.005;            // m/s
+  double rest_angular = 0.05;            // rad/s
+  int rest_steps = 100;
+  double max_drop_time = 5.0;            // s of simulated time
+  double fall_below = 0.3;               // m
+};
+
+// Result of check(): the goal pose simulated for settle_time.
+struct PoseCheck {
+  bool confirmed = false;
+  double moved_m = 0.0;        // displacement of the centre of mass, goal -> final
+  double turned_deg = 0.0;     // rotation angle, goal -> final
+  bool aborted = false;        // stopped early (moved past abort_*)
+  double sim_time = 0.0;       // s simulated
+  double wall_ms = 0.0;
+  Eigen::Isometry3d X_WO_final = Eigen::Isometry3d::Identity();
+};
+
+// Result of drop(): the object released at rest from X_WO_start.
+struct DropResult {
+  bool at_rest = false;        // velocities stayed below the thresholds for rest_steps steps
+  bool fell_off = false;       // dropped below the area
+  int steps = 0;               // simulation steps taken
+  double sim_time = 0.0;       // s simulated
+  double wall_ms = 0.0;        // wall time of the drop (world set-up + stepping; shapes prebuilt)
+  Eigen::Isometry3d X_WO_rest = Eigen::Isometry3d::Identity();  // last pose (resting pose if at_rest)
+};
+
+// Builds the collision shapes once per object/area pair; every check() or drop() runs in a fresh
+// dynamics world, so results do not depend on earlier calls (deterministic).
+// Not thread-safe: use one PhysicsValidator per thread.
+class PhysicsValidator {
+ public:
+  // Throws std::invalid_argument for an empty mesh or a bad config value (naming the field).
+  PhysicsValidator(const Mesh& object_O, const Mesh& area_W, const ValidatorConfig& config = {});
+  ~PhysicsValidator();
+  PhysicsValidator(const PhysicsValidator&) = delete;
+  PhysicsValidator& operator=(const PhysicsValidator&) = delete;
+
+  PoseCheck check(const Eigen::Isometry3d& X_WO_goal) const;
+  DropResult drop(const Eigen::Isometry3d& X_WO_start) const;
+
+  const ValidatorConfig& config() const;
+  double mass() const;          // kg
+  int convexPieces() const;     // number of convex hulls of the object
+  double shapeBuildMs() const;  // one-off cost of building the shapes
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Rotation angle between two orientations, degrees in [0, 180].
+double rotationAngleDeg(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b);
+
+}  // namespace validation
+}  // namespace place_planner

@@ -1,0 +1,151 @@
+#include "place_planner/validation/mesh_variants.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <queue>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <tuple>
+#include <vector>
+
+namespace place_planner {
+namespace validation {
+namespace {
+
+// Builds a mesh from triangles over `vertices`, keeping only the vertices used.
+Mesh fromTriangles(const std::vector<Eigen::Vector3d>& vertices,
+                   const std::vector<std::array<int, 3>>& tris, const std::string& name) {
+  std::vector<int> remap(vertices.size(), -1);
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::vector<int>> polys;
+  polys.reserve(tris.size());
+  for (const auto& t : tris) {
+    std::vector<int> p;
+    for (int i : t) {
+      if (remap[i] < 0) {
+        remap[i] = static_cast<int>(v.size());
+        v.push_back(vertices[i]);
+      }
+      p.push_back(remap[i]);
+    }
+    polys.push_back(std::move(p));
+  }
+  return buildMesh(v, polys, name);
+}
+
+// One clustering pass with cell size h: returns the clustered vertices and triangles.
+std::pair<std::vector<Eigen::Vector3d>, std::vector<std::array<int, 3>>> cluster(const Mesh& m,
+                                                                                 double h) {
+  const Eigen::Vector3d lo = m.properties.bounds_min;
+  std::map<std::tuple<long, long, long>, int> cell_of;
+  std::vector<Eigen::Vector3d> sum;
+  std::vector<int> count;
+  std::vector<int> vmap(m.vertices.size());
+  for (size_t i = 0; i < m.vertices.size(); ++i) {
+    const Eigen::Vector3d q = (m.vertices[i] - lo) / h;
+    const auto key = std::make_tuple(static_cast<long>(std::floor(q.x())),
+                                     static_cast<long>(std::floor(q.y())),
+                                     static_cast<long>(std::floor(q.z())));
+    auto it = cell_of.find(key);
+    if (it == cell_of.end()) {
+      it = cell_of.emplace(key, static_cast<int>(sum.size())).first;
+      sum.push_back(Eigen::Vector3d::Zero());
+      count.push_back(0);
+    }
+    vmap[i] = it->second;
+    sum[it->second] += m.vertices[i];
+    ++count[it->second];
+  }
+  for (size_t c = 0; c < sum.size(); ++c) sum[c] /= count[c];
+  std::set<std::array<int, 3>> seen;
+  std::vector<std::array<int, 3>> tris;
+  for (const auto& t : m.triangles) {
+    const std::array<int, 3> r{vmap[t[0]], vmap[t[1]], vmap[t[2]]};
+    if (r[0] == r[1] || r[1] == r[2] || r[0] == r[2]) continue;
+    std::array<int, 3> key = r;
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) continue;
+    if ((sum[r[1]] - sum[r[0]]).cross(sum[r[2]] - sum[r[0]]).norm() < 1e-14) continue;
+    tris.push_back(r);
+  }
+  return {sum, tris};
+}
+
+}  // namespace
+
+Mesh decimateByClustering(const Mesh& mesh, int target) {
+  if (target < 4) throw std::invalid_argument("decimateByClustering: target_triangles < 4");
+  if (static_cast<int>(mesh.triangles.size()) <= target) return mesh;
+  const Eigen::Vector3d ext = mesh.properties.bounds_max - mesh.properties.bounds_min;
+  double lo = ext.maxCoeff() * 1e-4, hi = ext.maxCoeff();  // fine (many triangles) .. coarse
+  double best_h = hi;
+  long best_err = -1;
+  for (int it = 0; it < 40; ++it) {
+    const double h = std::sqrt(lo * hi);
+    const int n = static_cast<int>(cluster(mesh, h).second.size());
+    const long err = std::labs(static_cast<long>(n) - target);
+    if (best_err < 0 || err < best_err) {
+      best_err = err;
+      best_h = h;
+    }
+    if (n > target) lo = h; else hi = h;
+    if (err == 0 || hi / lo < 1.0005) break;
+  }
+  auto [v, t] = cluster(mesh, best_h);
+  return fromTriangles(v, t, "decimated mesh");
+}
+
+Mesh punchHoles(const Mesh& mesh, double fraction, std::uint32_t seed, double patch_fraction) {
+  if (!(fraction >= 0.0 && fraction <= 0.9))
+    throw std::invalid_argument("punchHoles: fraction must be in [0, 0.9]");
+  const int nt = static_cast<int>(mesh.triangles.size());
+  const int to_remove = static_cast<int>(std::round(fraction * nt));
+  const int patch = std::max(1, static_cast<int>(std::round(patch_fraction * nt)));
+  std::map<std::pair<int, int>, std::vector<int>> edge_tris;
+  for (int t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      int i = mesh.triangles[t][k], j = mesh.triangles[t][(k + 1) % 3];
+      if (i > j) std::swap(i, j);
+      edge_tris[{i, j}].push_back(t);
+    }
+  std::vector<std::vector<int>> nbr(nt);
+  for (const auto& [e, ts] : edge_tris)
+    for (int a : ts)
+      for (int b : ts)
+        if (a != b) nbr[a].push_back(b);
+  std::mt19937 rng(seed);
+  std::vector<char> removed(nt, 0);
+  int n_removed = 0;
+  while (n_removed < to_remove) {
+    std::uniform_int_distribution<int> pick(0, nt - 1);
+    int s = pick(rng);
+    while (removed[s]) s = (s + 1) % nt;
+    std::queue<int> q;
+    q.push(s);
+    removed[s] = 1;
+    int in_patch = 1;
+    ++n_removed;
+    while (!q.empty() && in_patch < patch && n_removed < to_remove) {
+      const int t = q.front();
+      q.pop();
+      for (int u : nbr[t]) {
+        if (removed[u] || in_patch >= patch || n_removed >= to_remove) continue;
+        removed[u] = 1;
+        ++in_patch;
+        ++n_removed;
+        q.push(u);
+      }
+    }
+  }
+  std::vector<std::array<int, 3>> keep;
+  for (int t = 0; t < nt; ++t)
+    if (!removed[t]) keep.push_back(mesh.triangles[t]);
+  return fromTriangles(mesh.vertices, keep, "holey mesh");
+}
+
+}  // namespace validation
+}  // namespace place_planner

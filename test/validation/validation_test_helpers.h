@@ -1,0 +1,23 @@
+// Shared-data lookup for the validation tests (same convention as test/core/test_helpers.h).
+#pragma once
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <string>
+
+namespace place_planner {
+namespace validation_test {
+
+inline std::string sharedData() { return PP_SHARED_DATA_DIR; }
+inline bool haveSharedData() {
+  struct stat st;
+  return stat((sharedData() + "/MANIFEST.tsv").c_str(), &st) == 0;
+}
+#define PP_VALIDATION_REQUIRE_SHARED_DATA()                                                   \
+  if (!::place_planner::validation_test::haveSharedData())                                    \
+  GTEST_SKIP() << "../shared/data not found at "                                              \
+               << ::place_planner::validation_test::sharedData()                              \
+               << ": the real-mesh tests need it beside the repository"
+
+}  // namespace validation_test
+}  // namespace place_planner

@@ -1,0 +1,40 @@
+# The ROS 1 node (a thin adapter over place_planner_core), the demo tools and the rostests.
+# Included by CMakeLists.txt after catkin_package(). No PCL headers: PolygonMesh is read and
+# written through sensor_msgs' PointCloud2 accessors, so nothing here needs find_package(PCL).
+
+# ---------------------------------------------------------------- adapter library
+add_library(place_planner_ros STATIC
+  src/node/conversions.cpp
+  src/node/markers.cpp
+  src/node/params.cpp
+  src/node/place_planner_node.cpp)
+target_include_directories(place_planner_ros PUBLIC
+  ${PROJECT_SOURCE_DIR}/include ${CATKIN_DEVEL_PREFIX}/include ${catkin_INCLUDE_DIRS})
+target_link_libraries(place_planner_ros PUBLIC place_planner_core ${catkin_LIBRARIES})
+target_compile_options(place_planner_ros PRIVATE ${PP_WARN})
+add_dependencies(place_planner_ros ${${PROJECT_NAME}_EXPORTED_TARGETS} ${catkin_EXPORTED_TARGETS})
+
+# ---------------------------------------------------------------- node and tools
+add_executable(place_planner_node src/node/main.cpp)
+target_link_libraries(place_planner_node place_planner_ros)
+target_compile_options(place_planner_node PRIVATE ${PP_WARN})
+
+add_executable(make_demo_bag src/tools/make_demo_bag.cpp)
+target_link_libraries(make_demo_bag place_planner_ros)
+target_compile_options(make_demo_bag PRIVATE ${PP_WARN})
+
+add_executable(demo_client src/tools/demo_client.cpp)
+target_link_libraries(demo_client place_planner_ros)
+target_compile_options(demo_client PRIVATE ${PP_WARN})
+
+# ---------------------------------------------------------------- rostests
+if(CATKIN_ENABLE_TESTING)
+  find_package(rostest REQUIRED)
+  add_rostest_gtest(place_planner_node_test test/ros/place_planner_node.test
+    test/ros/test_place_planner_node.cpp)
+  target_link_libraries(place_planner_node_test place_planner_ros)
+  add_dependencies(place_planner_node_test place_planner_node)
+  # The test starts the node itself once, with a bad parameter, to see it refuse.
+  target_compile_definitions(place_planner_node_test PRIVATE
+    PP_NODE_BINARY="$<TARGET_FILE:place_planner_node>")
+endif()

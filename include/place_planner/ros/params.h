@@ -1,0 +1,28 @@
+// Node parameters: PlannerConfig (include/place_planner/config.h) field for field, plus the few
+// settings that only the ROS layer has (voxblox_ros/ros_params.h style). config/place_planner.yaml
+// mirrors both structs; a missing parameter keeps the struct default.
+#pragma once
+#include <string>
+
+#include <ros/node_handle.h>
+
+#include "place_planner/config.h"
+
+namespace place_planner {
+
+struct NodeConfig {
+  std::string planning_frame = "world";  // frame of the placement area and of every answer
+  double tf_timeout = 0.5;               // s, wait for a transform before TF_ERROR
+  double feedback_period = 0.05;         // s, at most this long between feedback messages
+  int marker_candidates = 10;            // object outlines drawn (best first)
+  int marker_text_count = 3;             // "Q = ..." labels for the best few
+  PlannerConfig planner;
+};
+
+// Reads the parameters from nh (the node's private namespace). Throws std::invalid_argument
+// naming the parameter for a wrong type ("parameter /place_planner/gravity must be a list of 3
+// numbers"), an unknown enum value, or a value out of range (place_planner::validate(), e.g.
+// "parameter /place_planner/friction = -0.1 is out of range (0 <= friction <= 10)").
+NodeConfig loadNodeConfig(const ros::NodeHandle& nh);
+
+}  // namespace place_planner

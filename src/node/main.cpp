@@ -1,0 +1,14 @@
+// The place_planner node: init, construct, spin. Bad parameters: the node names them and exits.
+#include "place_planner/ros/place_planner_node.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "place_planner");
+  try {
+    place_planner::PlacePlannerNode node(ros::NodeHandle(), ros::NodeHandle("~"));
+    ros::spin();
+  } catch (const std::invalid_argument& e) {
+    ROS_FATAL("place_planner: %s; not starting", e.what());
+    return 1;
+  }
+  return 0;
+}

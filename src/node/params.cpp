@@ -1,0 +1,130 @@
+#include "place_planner/ros/params.h"
+
+#include <stdexcept>
+
+#include <XmlRpcValue.h>
+
+namespace place_planner {
+namespace {
+
+// Reads one parameter of the node's private namespace; a missing one keeps `value`.
+class ParamReader {
+ public:
+  explicit ParamReader(const ros::NodeHandle& nh) : nh_(nh) {}
+
+  std::string fullName(const std::string& key) const { return nh_.resolveName(key); }
+
+  void read(const std::string& key, double* value) const {
+    XmlRpc::XmlRpcValue v;
+    if (!nh_.getParam(key, v)) return;
+    if (!number(v, value)) fail(key, "must be a number");
+  }
+
+  void read(const std::string& key, int* value) const {
+    XmlRpc::XmlRpcValue v;
+    if (!nh_.getParam(key, v)) return;
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeInt) fail(key, "must be an integer");
+    *value = static_cast<int>(v);
+  }
+
+  void read(const std::string& key, std::string* value) const {
+    XmlRpc::XmlRpcValue v;
+    if (!nh_.getParam(key, v)) return;
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeString) fail(key, "must be a string");
+    *value = static_cast<std::string>(v);
+  }
+
+  void read(const std::string& key, Eigen::Vector3d* value) const {
+    XmlRpc::XmlRpcValue v;
+    if (!nh_.getParam(key, v)) return;
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeArray || v.size() != 3) {
+      fail(key, "must be a list of 3 numbers");
+    }
+    for (int i = 0; i < 3; ++i) {
+      if (!number(v[i], &(*value)[i])) fail(key, "must be a list of 3 numbers");
+    }
+  }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& why) const {
+    throw std::invalid_argument("parameter " + fullName(key) + " " + why);
+  }
+
+ private:
+  static bool number(XmlRpc::XmlRpcValue& v, double* out) {
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      *out = static_cast<double>(v);
+      return true;
+    }
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {  // YAML "1" is an int
+      *out = static_cast<int>(v);
+      return true;
+    }
+    return false;
+  }
+
+  ros::NodeHandle nh_;
+};
+
+BackendKind backendFromString(const std::string& s) {
+  if (s == "auto") return BackendKind::kAuto;
+  if (s == "cpu") return BackendKind::kCpu;
+  if (s == "cuda") return BackendKind::kCuda;
+  throw std::invalid_argument("backend = '" + s + "' is unknown (use auto, cpu or cuda)");
+}
+
+}  // namespace
+
+NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
+  const ParamReader r(nh);
+  NodeConfig c;
+  r.read("planning_frame", &c.planning_frame);
+  r.read("tf_timeout", &c.tf_timeout);
+  r.read("feedback_period", &c.feedback_period);
+  r.read("marker_candidates", &c.marker_candidates);
+  r.read("marker_text_count", &c.marker_text_count);
+  if (c.planning_frame.empty()) r.fail("planning_frame", "must not be empty");
+  if (!(c.tf_timeout >= 0 && c.tf_timeout <= 60)) r.fail("tf_timeout", "is out of range (0 .. 60 s)");
+  if (!(c.feedback_period > 0 && c.feedback_period <= 0.1)) {
+    r.fail("feedback_period", "is out of range (0 < feedback_period <= 0.1 s)");
+  }
+  if (c.marker_candidates < 0) r.fail("marker_candidates", "is out of range (>= 0)");
+  if (c.marker_text_count < 0) r.fail("marker_text_count", "is out of range (>= 0)");
+
+  // PlannerConfig, field for field (include/place_planner/config.h).
+  PlannerConfig& p = c.planner;
+  r.read("gravity", &p.gravity);
+  r.read("approach", &p.approach);
+  r.read("friction", &p.friction);
+  r.read("floor_point_spacing", &p.floor_point_spacing);
+  r.read("min_floor_points", &p.min_floor_points);
+  r.read("lowest_n", &p.lowest_n);
+  r.read("max_rotations", &p.max_rotations);
+  r.read("sphere_radius", &p.sphere_radius);
+  r.read("grid_cell_size", &p.grid_cell_size);
+  std::string orientation = toString(p.orientation);
+  r.read("orientation", &orientation);
+  r.read("time_budget_ms", &p.time_budget_ms);
+  r.read("max_candidates", &p.max_candidates);
+  r.read("threads", &p.threads);
+  r.read("max_local_optimisation_steps", &p.max_local_optimisation_steps);
+  r.read("min_quality", &p.min_quality);
+  r.read("merge_distance", &p.merge_distance);
+  r.read("merge_angle_deg", &p.merge_angle_deg);
+  std::string backend = "auto";
+  r.read("backend", &backend);
+  r.read("region_min", &p.region_min);
+  r.read("region_max", &p.region_max);
+  try {
+    p.orientation = orientationModeFromString(orientation);
+    p.backend = backendFromString(backend);
+    validate(p);  // "friction = -0.1 is out of range (...)"
+  } catch (const std::invalid_argument& e) {
+    // validate() starts with the field name, which is the parameter's name.
+    std::string what = e.what();
+    if (what.rfind("orientation_mode", 0) == 0) what.replace(0, 16, "orientation");
+    throw std::invalid_argument("parameter " + r.fullName("") + "/" + what);
+  }
+  return c;
+}
+
+}  // namespace place_planner

@@ -1,0 +1,482 @@
+// rostest of the place_planner node (test/ros/place_planner_node.test): every test sends real
+// goals through actionlib and checks the answer's geometry, not only that something came back.
+// Frames: W = world (the node's planning frame), S = sensor (a static transform this test
+// broadcasts), O = the object's mesh frame.
+#include <actionlib/client/simple_action_client.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <mutex>
+#include <set>
+
+#include "place_planner/PlacePlanAction.h"
+#include "place_planner/ros/conversions.h"
+#include "place_planner/ros/markers.h"
+#include "place_planner/ros/params.h"
+#include "place_planner/scenes.h"
+
+namespace place_planner {
+namespace {
+
+using Client = actionlib::SimpleActionClient<PlacePlanAction>;
+using Result = PlacePlanResult;
+
+constexpr char kAction[] = "/place_planner/place_plan";
+// Test 2 and the issue: the same scene given in another frame gives the same answer to 1 mm.
+constexpr double kSameAnswer = 1e-3;
+// Poses copied or composed in double precision: only rounding separates them.
+constexpr double kExact = 1e-6;
+// A vertex resting on the area (the planner's contact tolerance is well below this).
+constexpr double kOnSurface = 2e-3;
+// Cancel must end the goal within 0.2 s (issue 4), measured at the client.
+constexpr double kCancelLatency = 0.2;
+// Feedback is promised every 100 ms; allow scheduling jitter on a loaded 2-core CI machine.
+constexpr double kFeedbackGap = 0.15;
+
+// The scene of the quick goals: a box on a 0.4 x 0.3 m plane at z = 0.
+Mesh testArea() { return scenes::plane(0.4, 0.3); }
+Mesh testObject() { return scenes::box(0.08, 0.06, 0.04); }
+// The scene of the long goals: the table with a 1 cm floor point grid.
+Mesh longArea() { return scenes::table(); }
+
+// Where the object's mesh frame is now (in W): above the area, turned about z.
+Eigen::Isometry3d X_WO_start() {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translate(Eigen::Vector3d(0.05, 0.02, 0.4));
+  X.rotate(Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()));
+  return X;
+}
+
+// The sensor frame: pose of S in W, broadcast as a static transform by main().
+Eigen::Isometry3d X_WS() {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translate(Eigen::Vector3d(0.3, -0.2, 0.7));
+  X.rotate(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, -0.5).normalized()));
+  return X;
+}
+
+Mesh mapped(const Mesh& m, const Eigen::Isometry3d& X) { return transformed(m, X.rotation(), X.translation()); }
+
+pcl_msgs::PolygonMesh meshMsg(const Mesh& mesh, const std::string& frame) {
+  pcl_msgs::PolygonMesh msg;
+  toMsg(mesh, frame, &msg);
+  return msg;
+}
+
+PlacePlanGoal quickGoal() {
+  PlacePlanGoal goal;
+  goal.object_pose.header.frame_id = "world";
+  toMsg(X_WO_start(), &goal.object_pose.pose);
+  goal.max_candidates = 50;  // all of them: test 2 compares the whole answer
+  return goal;
+}
+
+PlacePlanGoal longGoal() {
+  PlacePlanGoal goal = quickGoal();
+  goal.object_mesh = meshMsg(testObject(), "");
+  goal.placement_area_mesh = meshMsg(longArea(), "world");
+  goal.floor_point_spacing = 0.01;
+  goal.max_candidates = 10;
+  return goal;
+}
+
+struct Answer {
+  actionlib::SimpleClientGoalState state{actionlib::SimpleClientGoalState::LOST};
+  Result result;
+};
+
+Client& client() {
+  static Client c(kAction, true);
+  return c;
+}
+
+Answer send(const PlacePlanGoal& goal, double timeout = 60.0) {
+  Client& c = client();
+  EXPECT_TRUE(c.waitForServer(ros::Duration(30.0)));
+  c.sendGoal(goal);
+  Answer a;
+  if (!c.waitForResult(ros::Duration(timeout))) {
+    ADD_FAILURE() << "no result within " << timeout << " s";
+    c.cancelGoal();
+    return a;
+  }
+  a.state = c.getState();
+  a.result = *c.getResult();
+  return a;
+}
+
+double distance(const geometry_msgs::Pose& a, const geometry_msgs::Pose& b) {
+  return (fromMsg(a).translation() - fromMsg(b).translation()).norm();
+}
+double angle(const geometry_msgs::Pose& a, const geometry_msgs::Pose& b) {
+  return Eigen::AngleAxisd(fromMsg(a).rotation().transpose() * fromMsg(b).rotation()).angle();
+}
+
+// The answer of test 1 (meshes from the topics); computed once, shared with test 2.
+const Answer& topicAnswer() {
+  static Answer answer;
+  static bool done = false;
+  if (done) return answer;
+  ros::NodeHandle nh;
+  static ros::Publisher object_pub = nh.advertise<pcl_msgs::PolygonMesh>("object_mesh", 1, true);
+  static ros::Publisher area_pub = nh.advertise<pcl_msgs::PolygonMesh>("placement_area_mesh", 1, true);
+  object_pub.publish(meshMsg(testObject(), ""));  // vertices in O
+  area_pub.publish(meshMsg(testArea(), "world"));
+  // The node may not have the latched meshes yet: NO_MESH is retried for a while.
+  for (int i = 0; i < 50; ++i) {
+    answer = send(quickGoal());
+    if (answer.result.error_code != Result::NO_MESH) break;
+    ros::WallDuration(0.1).sleep();
+  }
+  done = true;
+  return answer;
+}
+
+// ---------------------------------------------------------------- 1
+TEST(PlacePlannerNode, MeshesFromTopicsGiveStablePoseInPlanningFrame) {
+  const Answer& a = topicAnswer();
+  ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  EXPECT_EQ(a.state, actionlib::SimpleClientGoalState::SUCCEEDED);
+  ASSERT_FALSE(a.result.candidates.empty());
+  EXPECT_GT(a.result.floor_points_evaluated, 0);
+  EXPECT_GT(a.result.planning_time, 0.0);
+  std::printf("[test 1] %zu candidates, %d floor points, planning_time %.3f s\n",
+              a.result.candidates.size(), a.result.floor_points_evaluated, a.result.planning_time);
+
+  const PlacementCandidate& best = a.result.candidates.front();
+  EXPECT_TRUE(best.stable);
+  EXPECT_GE(best.quality, 0.3);  // the message's own threshold for stable
+  EXPECT_EQ(best.pose.header.frame_id, "world");
+  for (size_t i = 1; i < a.result.candidates.size(); ++i) {  // ranked
+    const auto& prev = a.result.candidates[i - 1];
+    const auto& c = a.result.candidates[i];
+    EXPECT_TRUE(prev.stable >= c.stable);
+    if (prev.stable == c.stable) EXPECT_GE(prev.quality, c.quality - 1e-9);
+  }
+
+  // A box resting on the plane z = 0: a whole face down, nothing below the plane.
+  const Eigen::Isometry3d X_WO = fromMsg(best.pose.pose);
+  const Mesh object = testObject();
+  double min_z = std::numeric_limits<double>::infinity();
+  for (const auto& v : object.vertices) min_z = std::min(min_z, (X_WO * v).z());
+  int down = 0;
+  for (const auto& v : object.vertices) down += (X_WO * v).z() < min_z + kOnSurface;
+  EXPECT_NEAR(min_z, 0.0, kOnSurface);
+  EXPECT_EQ(down, 4) << "a box at rest has one face (4 vertices) on the plane";
+  // Its contacts are on the plane, normals up, and inside the area.
+  ASSERT_GE(best.contact_points.size(), 3u);
+  for (size_t i = 0; i < best.contact_points.size(); ++i) {
+    EXPECT_NEAR(best.contact_points[i].z, 0.0, kOnSurface);
+    EXPECT_LE(std::abs(best.contact_points[i].x), 0.2 + kOnSurface);
+    EXPECT_LE(std::abs(best.contact_points[i].y), 0.15 + kOnSurface);
+    EXPECT_NEAR(best.contact_normals[i].z, 1.0, 1e-3);
+  }
+  // The path ends at the goal pose and starts above it.
+  const auto& path = best.intermediate_poses;
+  EXPECT_EQ(path.header.frame_id, "world");
+  ASSERT_GE(path.poses.size(), 2u);
+  EXPECT_LT(distance(path.poses.back(), best.pose.pose), kExact);
+  EXPECT_LT(angle(path.poses.back(), best.pose.pose), kExact);
+  EXPECT_GT(path.poses.front().position.z, best.pose.pose.position.z);
+  // Without a grasp the gripper pose is the identity.
+  EXPECT_NEAR(best.gripper_pose.pose.orientation.w, 1.0, kExact);
+  EXPECT_NEAR(std::abs(best.gripper_pose.pose.position.z), 0.0, kExact);
+}
+
+// ---------------------------------------------------------------- 2
+TEST(PlacePlannerNode, InlineMeshesInTransformedFrameGiveSameAnswer) {
+  const Answer& reference = topicAnswer();
+  ASSERT_EQ(reference.result.error_code, Result::SUCCESS) << reference.result.error_message;
+
+  // Everything in the sensor frame S: the area, the object's vertices and the object's pose.
+  const Eigen::Isometry3d X_SW = X_WS().inverse();
+  PlacePlanGoal goal = quickGoal();
+  goal.placement_area_mesh = meshMsg(mapped(testArea(), X_SW), "sensor");
+  goal.object_mesh = meshMsg(mapped(testObject(), X_SW * X_WO_start()), "sensor");
+  goal.object_pose.header.frame_id = "sensor";
+  toMsg(Eigen::Isometry3d(X_SW * X_WO_start()), &goal.object_pose.pose);
+  const Answer a = send(goal);
+  ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+
+  const auto& ref = reference.result.candidates;
+  const auto& got = a.result.candidates;
+  ASSERT_EQ(got.size(), ref.size());
+  EXPECT_EQ(got.front().pose.header.frame_id, "world");
+  EXPECT_NEAR(got.front().quality, ref.front().quality, 1e-3);
+  // Same set of candidates (ties in Q may order them differently): each has a twin within 1 mm.
+  for (const auto* pair : {&ref, &got}) {
+    const auto& from = *pair;
+    const auto& to = pair == &ref ? got : ref;
+    for (const auto& c : from) {
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& d : to) {
+        if (angle(c.pose.pose, d.pose.pose) < 0.01) best = std::min(best, distance(c.pose.pose, d.pose.pose));
+      }
+      EXPECT_LT(best, kSameAnswer) << "candidate at (" << c.pose.pose.position.x << ", "
+                                   << c.pose.pose.position.y << ", " << c.pose.pose.position.z
+                                   << ") has no twin";
+    }
+  }
+}
+
+// ---------------------------------------------------------------- 3
+TEST(PlacePlannerNode, NanVertexIsInvalidMeshAndNodeKeepsServing) {
+  PlacePlanGoal goal = quickGoal();
+  pcl_msgs::PolygonMesh object = meshMsg(testObject(), "");
+  // Vertex 5's y: cloud fields x, y, z are float32 at offsets 0, 4, 8.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(&object.cloud.data[5 * object.cloud.point_step + 4], &nan, sizeof nan);
+  goal.object_mesh = object;
+  goal.placement_area_mesh = meshMsg(testArea(), "world");
+  const Answer bad = send(goal);
+  EXPECT_EQ(bad.result.error_code, Result::INVALID_MESH);
+  EXPECT_EQ(bad.state, actionlib::SimpleClientGoalState::ABORTED);
+  EXPECT_NE(bad.result.error_message.find("object mesh"), std::string::npos) << bad.result.error_message;
+  EXPECT_NE(bad.result.error_message.find("vertex 5"), std::string::npos) << bad.result.error_message;
+  EXPECT_TRUE(bad.result.candidates.empty());
+
+  goal.object_mesh = meshMsg(testObject(), "");
+  const Answer good = send(goal);
+  EXPECT_EQ(good.result.error_code, Result::SUCCESS) << good.result.error_message;
+  ASSERT_FALSE(good.result.candidates.empty());
+  EXPECT_TRUE(good.result.candidates.front().stable);
+}
+
+// ---------------------------------------------------------------- 4
+TEST(PlacePlannerNode, MeshInUnknownFrameIsTfError) {
+  PlacePlanGoal goal = quickGoal();
+  goal.object_mesh = meshMsg(testObject(), "");
+  goal.placement_area_mesh = meshMsg(testArea(), "nowhere");
+  const Answer a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::TF_ERROR);
+  EXPECT_NE(a.result.error_message.find("'nowhere'"), std::string::npos) << a.result.error_message;
+  EXPECT_NE(a.result.error_message.find("placement area mesh"), std::string::npos)
+      << a.result.error_message;
+}
+
+// Feedback of the goal that is running, as the client sees it.
+struct FeedbackLog {
+  std::mutex mutex;
+  std::vector<std::pair<ros::WallTime, PlacePlanFeedback>> items;
+  void add(const PlacePlanFeedbackConstPtr& f) {
+    std::lock_guard<std::mutex> lock(mutex);
+    items.emplace_back(ros::WallTime::now(), *f);
+  }
+  std::vector<std::pair<ros::WallTime, PlacePlanFeedback>> copy() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return items;
+  }
+};
+
+void sendWithFeedback(const PlacePlanGoal& goal, FeedbackLog* log) {
+  ASSERT_TRUE(client().waitForServer(ros::Duration(30.0)));
+  client().sendGoal(goal, Client::SimpleDoneCallback(), Client::SimpleActiveCallback(),
+                    [log](const PlacePlanFeedbackConstPtr& f) { log->add(f); });
+}
+
+// ---------------------------------------------------------------- 5
+TEST(PlacePlannerNode, CancelEndsGoalQuicklyWithCandidatesSoFar) {
+  FeedbackLog log;
+  sendWithFeedback(longGoal(), &log);
+  // Cancel once some candidates exist (or after 3 s at the latest).
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(3.0);
+  int candidates_at_cancel = 0;
+  while (ros::WallTime::now() < give_up) {
+    const auto items = log.copy();
+    if (!items.empty() && items.back().second.candidates_so_far > 0) {
+      candidates_at_cancel = items.back().second.candidates_so_far;
+      break;
+    }
+    ros::WallDuration(0.005).sleep();
+  }
+  ASSERT_EQ(client().getState(), actionlib::SimpleClientGoalState::ACTIVE)
+      << "the long goal ended before it could be cancelled: make it longer";
+  const ros::WallTime t0 = ros::WallTime::now();
+  client().cancelGoal();
+  ASSERT_TRUE(client().waitForResult(ros::Duration(5.0)));
+  const double latency = (ros::WallTime::now() - t0).toSec();
+  std::printf("[test 5] cancel latency %.1f ms, candidates at cancel %d\n", latency * 1e3,
+              candidates_at_cancel);
+  EXPECT_LT(latency, kCancelLatency);
+  EXPECT_EQ(client().getState(), actionlib::SimpleClientGoalState::PREEMPTED);
+  const Result r = *client().getResult();
+  EXPECT_EQ(r.error_code, Result::PREEMPTED) << r.error_message;
+  const auto items = log.copy();
+  ASSERT_FALSE(items.empty());
+  EXPECT_LT(r.floor_points_evaluated, items.back().second.floor_points_total) << "it was not cut short";
+  ASSERT_GT(candidates_at_cancel, 0) << "no candidate within 3 s";
+  ASSERT_FALSE(r.candidates.empty());
+  for (const auto& c : r.candidates) {
+    EXPECT_EQ(c.pose.header.frame_id, "world");
+    EXPECT_LE(c.quality, 1.0);
+  }
+}
+
+// ---------------------------------------------------------------- 6
+TEST(PlacePlannerNode, FeedbackDuringLongPlanAndDocumentedMarkers) {
+  FeedbackLog log;
+  sendWithFeedback(longGoal(), &log);
+  ros::WallDuration(1.0).sleep();
+  const bool still_running = client().getState() == actionlib::SimpleClientGoalState::ACTIVE;
+  client().cancelGoal();
+  ASSERT_TRUE(client().waitForResult(ros::Duration(5.0)));
+  EXPECT_TRUE(still_running) << "the long goal took less than 1 s: make it longer";
+  const auto items = log.copy();
+  ASSERT_GE(items.size(), 7u) << "feedback every 100 ms over 1 s";
+  double max_gap = 0;
+  for (size_t i = 1; i < items.size(); ++i) {
+    max_gap = std::max(max_gap, (items[i].first - items[i - 1].first).toSec());
+    EXPECT_GE(items[i].second.elapsed_time, items[i - 1].second.elapsed_time);
+    EXPECT_GE(items[i].second.floor_points_done, items[i - 1].second.floor_points_done);
+  }
+  std::printf("[test 6] %zu feedback messages, largest gap %.1f ms\n", items.size(), max_gap * 1e3);
+  EXPECT_LT(max_gap, kFeedbackGap);
+  EXPECT_GT(items.back().second.floor_points_total, 1000);
+  EXPECT_GT(items.back().second.floor_points_done, 0);
+
+  // Markers of a completed goal: one batch, DELETEALL first, every documented namespace.
+  std::mutex mutex;
+  std::vector<visualization_msgs::MarkerArray> batches;
+  ros::NodeHandle nh;
+  ros::Subscriber sub = nh.subscribe<visualization_msgs::MarkerArray>(
+      "/place_planner/markers", 10, [&](const visualization_msgs::MarkerArrayConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        batches.push_back(*m);
+      });
+  // Latched: the previous (cancelled) goal's batch arrives first.
+  ros::WallDuration(0.5).sleep();
+  size_t before;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    before = batches.size();
+  }
+  PlacePlanGoal goal = quickGoal();
+  goal.object_mesh = meshMsg(testObject(), "");
+  goal.placement_area_mesh = meshMsg(testArea(), "world");
+  const Answer a = send(goal);
+  ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  for (int i = 0; i < 50; ++i) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (batches.size() > before) break;
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_GT(batches.size(), before) << "no markers after the goal";
+  const auto& batch = batches.back();
+  ASSERT_FALSE(batch.markers.empty());
+  EXPECT_EQ(batch.markers.front().action, visualization_msgs::Marker::DELETEALL);
+  std::set<std::string> ns;
+  for (size_t i = 1; i < batch.markers.size(); ++i) {
+    EXPECT_EQ(batch.markers[i].header.frame_id, "world");
+    ns.insert(batch.markers[i].ns);
+  }
+  for (const char* expected :
+       {marker_ns::kPlacementArea, marker_ns::kCandidates, marker_ns::kContacts,
+        marker_ns::kContactNormals, marker_ns::kFloorPoints, marker_ns::kBestPath,
+        marker_ns::kQuality}) {
+    EXPECT_EQ(ns.count(expected), 1u) << "namespace " << expected << " missing";
+  }
+  EXPECT_EQ(ns.size(), 7u);
+  // One object per candidate (up to marker_candidates = 10), coloured by Q.
+  int objects = 0;
+  for (const auto& m : batch.markers) objects += m.ns == marker_ns::kCandidates;
+  EXPECT_EQ(objects, std::min<int>(10, a.result.candidates.size()));
+}
+
+// ---------------------------------------------------------------- 7
+TEST(PlacePlannerNode, GripperPoseIsPoseComposedWithGrasp) {
+  PlacePlanGoal goal = quickGoal();
+  goal.object_mesh = meshMsg(testObject(), "");
+  goal.placement_area_mesh = meshMsg(testArea(), "world");
+  Eigen::Isometry3d X_OG = Eigen::Isometry3d::Identity();
+  X_OG.translate(Eigen::Vector3d(0.01, -0.02, 0.12));
+  X_OG.rotate(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()) *
+              Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
+  goal.has_grasp = true;
+  toMsg(X_OG, &goal.grasp);
+  const Answer a = send(goal);
+  ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  ASSERT_FALSE(a.result.candidates.empty());
+  for (const auto& c : a.result.candidates) {
+    EXPECT_EQ(c.gripper_pose.header.frame_id, c.pose.header.frame_id);
+    geometry_msgs::Pose expected;
+    toMsg(Eigen::Isometry3d(fromMsg(c.pose.pose) * X_OG), &expected);
+    EXPECT_LT(distance(c.gripper_pose.pose, expected), kExact);
+    EXPECT_LT(angle(c.gripper_pose.pose, expected), kExact);
+    // The gripper is 12 cm from the object's origin, wherever the object goes.
+    EXPECT_NEAR((fromMsg(c.gripper_pose.pose).translation() - fromMsg(c.pose.pose).translation()).norm(),
+                X_OG.translation().norm(), kExact);
+  }
+}
+
+// ---------------------------------------------------------------- parameters
+TEST(PlacePlannerParams, OutOfRangeAndWrongTypeAreNamed) {
+  ros::NodeHandle nh("/params_test");
+  nh.setParam("friction", -0.5);
+  try {
+    loadNodeConfig(nh);
+    ADD_FAILURE() << "friction -0.5 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/params_test/friction"), std::string::npos) << e.what();
+  }
+  nh.setParam("friction", 0.4);
+  nh.setParam("gravity", std::string("down"));
+  try {
+    loadNodeConfig(nh);
+    ADD_FAILURE() << "gravity 'down' accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/params_test/gravity"), std::string::npos) << e.what();
+  }
+  nh.setParam("gravity", std::vector<double>{0.0, -1.0, 0.0});
+  nh.setParam("orientation", std::string("keep"));
+  const NodeConfig c = loadNodeConfig(nh);
+  EXPECT_DOUBLE_EQ(c.planner.friction, 0.4);
+  EXPECT_EQ(c.planner.gravity, Eigen::Vector3d(0, -1, 0));
+  EXPECT_EQ(c.planner.orientation, OrientationMode::kKeep);
+  EXPECT_EQ(c.planner.max_candidates, PlannerConfig().max_candidates);  // default kept
+  nh.deleteParam("");
+}
+
+TEST(PlacePlannerParams, NodeRefusesToStartWithBadParameter) {
+  const std::string command = std::string(PP_NODE_BINARY) +
+                              " __name:=bad_place_planner _max_rotations:=99 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buf[512];
+  while (fgets(buf, sizeof buf, pipe)) output += buf;
+  const int status = pclose(pipe);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << output;
+  EXPECT_NE(output.find("/bad_place_planner/max_rotations"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace place_planner
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "place_planner_node_test");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  tf2_ros::StaticTransformBroadcaster broadcaster;
+  geometry_msgs::TransformStamped T = tf2::eigenToTransform(place_planner::X_WS());
+  T.header.frame_id = "world";
+  T.child_frame_id = "sensor";
+  T.header.stamp = ros::Time::now();
+  broadcaster.sendTransform(T);
+  const int rc = RUN_ALL_TESTS();
+  spinner.stop();
+  ros::shutdown();
+  return rc;
+}

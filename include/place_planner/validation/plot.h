@@ -1,0 +1,26 @@
+// Small PNG charts for the benchmark (OpenCV drawing, no plotting library needed).
+#pragma once
+#include <string>
+#include <vector>
+
+namespace place_planner {
+namespace validation {
+
+struct Series {
+  std::string name;
+  std::vector<double> y;  // one per x value; NaN leaves a gap
+};
+
+// Line chart: every series against x, with markers, axes, ticks and a legend.
+// Throws std::runtime_error when the file cannot be written.
+void plotLines(const std::string& path, const std::string& title, const std::string& x_label,
+               const std::string& y_label, const std::vector<double>& x,
+               const std::vector<Series>& series);
+
+// Grouped bar chart: one group per label, one bar per series; y axis from y_min to y_max.
+void plotBars(const std::string& path, const std::string& title, const std::string& y_label,
+              const std::vector<std::string>& labels, const std::vector<Series>& series,
+              double y_min, double y_max, double reference_line = -1.0);
+
+}  // namespace validation
+}  // namespace place_planner

@@ -1,0 +1,243 @@
+// The benchmark suite of issue 5 (scripts/bench runs it): every object x area pair, planner and
+// Bullet in this one process. Writes scenes.csv, checks.csv, drops.csv, fig6.csv, results.md
+// and the PNG plots.
+//
+//   place_planner_suite --data ../shared/data --out DIR [--plots DIR] [--pairs SUBSTR,...]
+//       [--holes 0.05,0.1,0.2 | --holes none] [--no-fig6] [--max-validated 5] [--max-drops 16]
+//       [--threads 1] [--friction 0.2]
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "place_planner/mesh_io.h"
+#include "place_planner/validation/mesh_variants.h"
+#include "place_planner/validation/plot.h"
+#include "place_planner/validation/suite.h"
+
+using namespace place_planner;
+using namespace place_planner::validation;
+
+namespace {
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+[[noreturn]] void usage(const char* msg) {
+  std::fprintf(stderr,
+               "%s\nusage: place_planner_suite --data DIR --out DIR [--plots DIR] [--pairs S,...]\n"
+               "  [--holes 0.05,0.1,0.2|none] [--no-fig6] [--max-validated N] [--max-drops N]\n"
+               "  [--threads N] [--friction MU]\n",
+               msg);
+  std::exit(2);
+}
+
+struct Fig6Row {
+  int triangles = 0;
+  StepTimes steps;
+  double total_ms = 0, per_floor_point_ms = 0;
+};
+
+// Time per planner step against object triangles (the paper's Fig. 6): the 16k YCB mug reduced
+// by vertex clustering to 200..1000 triangles, planned on the books stack, median of 3 runs.
+std::vector<Fig6Row> fig6(const std::string& data, const SuiteConfig& cfg) {
+  const Mesh full = loadMesh(data + "/objects/mug_ycb025.ply");
+  const Mesh area = loadMesh(data + "/areas/books_stack.ply");
+  std::vector<Fig6Row> rows;
+  for (int target = 200; target <= 1000; target += 100) {
+    const Mesh m = decimateByClustering(full, target);
+    std::vector<PlanStats> runs;
+    for (int k = 0; k < 3; ++k) runs.push_back(Planner().plan(m, area, cfg.planner).stats);
+    auto med = [&](auto get) {
+      std::vector<double> v;
+      for (const auto& s : runs) v.push_back(get(s));
+      return median(v);
+    };
+    Fig6Row r;
+    r.triangles = static_cast<int>(m.triangles.size());
+    r.steps.floor_points = med([](const PlanStats& s) { return s.steps.floor_points; });
+    r.steps.first_contact = med([](const PlanStats& s) { return s.steps.first_contact; });
+    r.steps.contact_points = med([](const PlanStats& s) { return s.steps.contact_points; });
+    r.steps.tilt_vertex = med([](const PlanStats& s) { return s.steps.tilt_vertex; });
+    r.steps.tilt_edge = med([](const PlanStats& s) { return s.steps.tilt_edge; });
+    r.steps.stability = med([](const PlanStats& s) { return s.steps.stability; });
+    r.steps.local_optimisation = med([](const PlanStats& s) { return s.steps.local_optimisation; });
+    r.total_ms = med([](const PlanStats& s) { return s.total_ms; });
+    r.per_floor_point_ms = med([](const PlanStats& s) {
+      return s.floor_points_total ? s.total_ms / s.floor_points_total : 0.0;
+    });
+    std::fprintf(stderr, "[fig6] %4d triangles: %.1f ms total\n", r.triangles, r.total_ms);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string data, out, plots;
+  std::vector<std::string> filters;
+  std::vector<double> holes = {0.05, 0.10, 0.20};
+  bool do_fig6 = true;
+  SuiteConfig cfg;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) usage(("missing value after " + a).c_str());
+      return argv[++i];
+    };
+    if (a == "--data") data = next();
+    else if (a == "--out") out = next();
+    else if (a == "--plots") plots = next();
+    else if (a == "--pairs") filters = split(next());
+    else if (a == "--holes") {
+      const std::string v = next();
+      holes.clear();
+      if (v != "none")
+        for (const auto& s : split(v)) holes.push_back(std::stod(s));
+    } else if (a == "--no-fig6") do_fig6 = false;
+    else if (a == "--max-validated") cfg.max_validated = std::stoi(next());
+    else if (a == "--max-drops") cfg.max_drops = std::stoi(next());
+    else if (a == "--threads") cfg.planner.threads = std::stoi(next());
+    else if (a == "--friction") cfg.planner.friction = std::stod(next());
+    else usage(("unknown argument " + a).c_str());
+  }
+  if (out.empty()) usage("--out is required");
+  if (plots.empty()) plots = out;
+
+  std::vector<ScenePair> pairs;
+  for (const auto& p : defaultPairs(data)) {
+    bool keep = filters.empty();
+    for (const auto& f : filters) keep = keep || p.name.find(f) != std::string::npos;
+    if (keep) pairs.push_back(p);
+  }
+  if (data.empty() || pairs.empty()) std::fprintf(stderr, "note: no shared data, built-in scenes only\n");
+  std::fprintf(stderr, "%zu pairs, holes variants: %zu\n", pairs.size(), holes.size());
+
+  // Full meshes: planner + validation + drops.
+  std::vector<SceneResult> full;
+  for (const auto& p : pairs) {
+    SceneResult r = runScene(p, cfg);
+    std::fprintf(stderr, "%-40s plan %7.1f ms  fp %3d  stable %2d  confirmed %d/%d  drops rest %d/%zu"
+                 " (%.1f ms)  %s\n", p.name.c_str(), r.stats.total_ms, r.stats.floor_points_total,
+                 r.stable, r.confirmed, r.validated, r.drops_at_rest, r.drops.size(), r.drop_ms_mean,
+                 r.error.c_str());
+    full.push_back(std::move(r));
+  }
+  // Holes: plan on the holey mesh, validate on the full one; no drops.
+  std::vector<std::vector<SceneResult>> holey;
+  for (double f : holes) {
+    SuiteConfig hc = cfg;
+    hc.hole_fraction = f;
+    hc.max_drops = 0;
+    std::vector<SceneResult> rs;
+    for (const auto& p : pairs) {
+      SceneResult r = runScene(p, hc);
+      std::fprintf(stderr, "%-40s %s confirmed %d/%d %s\n", p.name.c_str(), r.variant.c_str(),
+                   r.confirmed, r.validated, r.error.c_str());
+      rs.push_back(std::move(r));
+    }
+    holey.push_back(std::move(rs));
+  }
+  std::vector<SceneResult> all = full;
+  for (const auto& rs : holey) all.insert(all.end(), rs.begin(), rs.end());
+  writeScenesCsv(all, out + "/scenes.csv");
+  writeChecksCsv(all, out + "/checks.csv");
+  writeDropsCsv(all, out + "/drops.csv");
+
+  std::ostringstream md;
+  md << "| suite | scenes | confirmed-stable precision | coverage | median plan ms | "
+        "median first stable ms | planner ms / floor pt | Bullet ms / drop | speed-up |\n"
+     << "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  const SuiteSummary sf = summarize(full);
+  md << markdownSummary(sf, "full meshes") << "\n";
+  for (size_t k = 0; k < holes.size(); ++k)
+    md << markdownSummary(summarize(holey[k]),
+                          std::to_string(static_cast<int>(std::lround(holes[k] * 100))) +
+                              "% holes (plan holey, validate full)")
+       << "\n";
+  md << "\n";
+
+  // Precision per scene (full and each holes variant).
+  {
+    std::vector<std::string> labels;
+    std::vector<Series> ser(1 + holes.size());
+    ser[0].name = "full mesh";
+    for (size_t k = 0; k < holes.size(); ++k)
+      ser[k + 1].name = std::to_string(static_cast<int>(std::lround(holes[k] * 100))) + "% holes";
+    for (size_t i = 0; i < full.size(); ++i) {
+      labels.push_back(full[i].pair.name);
+      auto val = [](const SceneResult& r) {
+        return r.validated ? r.precision() : std::numeric_limits<double>::quiet_NaN();
+      };
+      ser[0].y.push_back(val(full[i]));
+      for (size_t k = 0; k < holes.size(); ++k) ser[k + 1].y.push_back(val(holey[k][i]));
+    }
+    plotBars(plots + "/precision_per_scene.png",
+             "Confirmed-stable precision per scene (Bullet, 2 s, <1 cm, <5 deg)",
+             "confirmed / validated", labels, ser, 0.0, 1.0, 0.97);
+  }
+
+  if (do_fig6 && !data.empty()) {
+    const std::vector<Fig6Row> rows = fig6(data, cfg);
+    std::ofstream csv(out + "/fig6.csv");
+    csv << "triangles,floor_points,first_contact,contact_points,tilt_vertex,tilt_edge,stability,"
+           "local_optimisation,total_ms,per_floor_point_ms\n";
+    md << "Time per planner step (ms, median of 3) against object triangles, YCB mug decimated by "
+          "vertex clustering, on books_stack:\n\n"
+       << "| triangles | floor points | first contact | contact points | tilt vertex | tilt edge |"
+          " stability | local opt. | total | per floor pt |\n"
+       << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    std::vector<double> x;
+    std::vector<Series> ser = {{"floor points", {}},  {"first contact", {}}, {"contact points", {}},
+                               {"tilt (vertex)", {}}, {"tilt (edge)", {}},   {"stability", {}},
+                               {"local optimisation", {}}, {"total", {}}};
+    for (const auto& r : rows) {
+      const StepTimes& s = r.steps;
+      csv << r.triangles << ',' << s.floor_points << ',' << s.first_contact << ','
+          << s.contact_points << ',' << s.tilt_vertex << ',' << s.tilt_edge << ',' << s.stability
+          << ',' << s.local_optimisation << ',' << r.total_ms << ',' << r.per_floor_point_ms << '\n';
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "| %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f | %.2f |\n",
+                    r.triangles, s.floor_points, s.first_contact, s.contact_points, s.tilt_vertex,
+                    s.tilt_edge, s.stability, s.local_optimisation, r.total_ms,
+                    r.per_floor_point_ms);
+      md << line;
+      x.push_back(r.triangles);
+      const double v[] = {s.floor_points, s.first_contact, s.contact_points, s.tilt_vertex,
+                          s.tilt_edge,    s.stability,     s.local_optimisation, r.total_ms};
+      for (size_t k = 0; k < ser.size(); ++k) ser[k].y.push_back(v[k]);
+    }
+    md << "\n";
+    plotLines(plots + "/fig6_step_times.png",
+              "Planner time per step vs object triangles (mug on books_stack)",
+              "object triangles (vertex clustering of the 16k YCB mug)", "ms (median of 3)", x, ser);
+  }
+
+  md << "Per scene (full meshes):\n\n" << markdownTable(full) << "\n";
+  for (size_t k = 0; k < holes.size(); ++k)
+    md << "Per scene, " << static_cast<int>(std::lround(holes[k] * 100)) << "% holes:\n\n"
+       << markdownTable(holey[k]) << "\n";
+  std::ofstream(out + "/results.md") << md.str();
+  std::cout << md.str().substr(0, md.str().find("\n\n")) << "\n";
+  return sf.errors == sf.scenes ? 1 : 0;
+}

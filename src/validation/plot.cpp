@@ -1,0 +1,187 @@
+#include "place_planner/validation/plot.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace place_planner {
+namespace validation {
+namespace {
+
+const cv::Scalar kBlack(0, 0, 0), kGrey(200, 200, 200), kWhite(255, 255, 255);
+// Tableau-like palette (BGR).
+const cv::Scalar kPalette[] = {{180, 119, 31}, {14, 127, 255}, {44, 160, 44}, {40, 39, 214},
+                               {189, 103, 148}, {75, 86, 140}, {194, 119, 227}, {127, 127, 127}};
+const int kFont = cv::FONT_HERSHEY_SIMPLEX;
+
+std::string num(double v) {
+  char b[32];
+  if (std::abs(v) >= 100 || v == std::floor(v)) std::snprintf(b, sizeof b, "%.0f", v);
+  else if (std::abs(v) >= 1) std::snprintf(b, sizeof b, "%.1f", v);
+  else std::snprintf(b, sizeof b, "%.2f", v);
+  return b;
+}
+
+double niceStep(double range, int ticks) {
+  const double raw = range / std::max(1, ticks);
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
+    if (m * p >= raw) return m * p;
+  return 10 * p;
+}
+
+struct Frame {
+  cv::Mat img;
+  cv::Rect box;  // plot area
+  double x0, x1, y0, y1;
+  cv::Point at(double x, double y) const {
+    return {box.x + static_cast<int>(std::lround((x - x0) / (x1 - x0) * box.width)),
+            box.y + box.height - static_cast<int>(std::lround((y - y0) / (y1 - y0) * box.height))};
+  }
+};
+
+Frame axes(const std::string& title, const std::string& y_label, double y0, double y1, int w,
+           int h) {
+  Frame f;
+  f.img = cv::Mat(h, w, CV_8UC3, kWhite);
+  f.box = cv::Rect(90, 50, w - 90 - 230, h - 50 - 110);
+  f.x0 = 0;
+  f.x1 = 1;
+  f.y0 = y0;
+  f.y1 = y1;
+  cv::putText(f.img, title, {f.box.x, 30}, kFont, 0.7, kBlack, 2, cv::LINE_AA);
+  const double step = niceStep(y1 - y0, 6);
+  for (double y = std::ceil(y0 / step) * step; y <= y1 + 1e-9; y += step) {
+    const cv::Point p = f.at(0, y);
+    cv::line(f.img, {f.box.x, p.y}, {f.box.x + f.box.width, p.y}, kGrey, 1);
+    cv::putText(f.img, num(y), {8, p.y + 5}, kFont, 0.45, kBlack, 1, cv::LINE_AA);
+  }
+  cv::rectangle(f.img, f.box, kBlack, 1);
+  // Vertical y label, drawn then rotated.
+  cv::Mat lab(24, 400, CV_8UC3, kWhite);
+  cv::putText(lab, y_label, {2, 18}, kFont, 0.5, kBlack, 1, cv::LINE_AA);
+  cv::Mat rot;
+  cv::rotate(lab, rot, cv::ROTATE_90_COUNTERCLOCKWISE);
+  const int top = std::max(0, f.box.y + f.box.height / 2 - 200);
+  const int rows = std::min(rot.rows, f.img.rows - top);
+  rot(cv::Rect(0, rot.rows - rows, rot.cols, rows)).copyTo(f.img(cv::Rect(52, top, rot.cols, rows)));
+  return f;
+}
+
+void legend(Frame& f, const std::vector<Series>& series) {
+  int y = f.box.y + 10;
+  const int x = f.box.x + f.box.width + 20;
+  for (size_t i = 0; i < series.size(); ++i) {
+    const cv::Scalar c = kPalette[i % 8];
+    cv::rectangle(f.img, {x, y - 8}, {x + 20, y + 4}, c, cv::FILLED);
+    cv::putText(f.img, series[i].name, {x + 28, y + 4}, kFont, 0.45, kBlack, 1, cv::LINE_AA);
+    y += 22;
+  }
+}
+
+void save(const std::string& path, const cv::Mat& img) {
+  if (!cv::imwrite(path, img)) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace
+
+void plotLines(const std::string& path, const std::string& title, const std::string& x_label,
+               const std::string& y_label, const std::vector<double>& x,
+               const std::vector<Series>& series) {
+  double ymax = 0;
+  for (const auto& s : series)
+    for (double v : s.y)
+      if (std::isfinite(v)) ymax = std::max(ymax, v);
+  if (ymax <= 0) ymax = 1;
+  const double ystep = niceStep(ymax * 1.05, 6);
+  Frame f = axes(title, y_label, 0, std::ceil(ymax * 1.05 / ystep) * ystep, 960, 560);
+  f.x0 = x.empty() ? 0 : *std::min_element(x.begin(), x.end());
+  f.x1 = x.empty() ? 1 : *std::max_element(x.begin(), x.end());
+  if (f.x1 <= f.x0) f.x1 = f.x0 + 1;
+  const double pad = 0.04 * (f.x1 - f.x0);
+  f.x0 -= pad;
+  f.x1 += pad;
+  const double xstep = niceStep(f.x1 - f.x0, 8);
+  for (double v = std::ceil(f.x0 / xstep) * xstep; v <= f.x1; v += xstep) {
+    const cv::Point p = f.at(v, f.y0);
+    cv::line(f.img, p, {p.x, p.y + 5}, kBlack, 1);
+    cv::putText(f.img, num(v), {p.x - 14, p.y + 22}, kFont, 0.45, kBlack, 1, cv::LINE_AA);
+  }
+  cv::putText(f.img, x_label, {f.box.x + f.box.width / 2 - 120, f.box.y + f.box.height + 50}, kFont,
+              0.55, kBlack, 1, cv::LINE_AA);
+  for (size_t i = 0; i < series.size(); ++i) {
+    const cv::Scalar c = kPalette[i % 8];
+    bool have_prev = false;
+    cv::Point prev;
+    for (size_t k = 0; k < x.size() && k < series[i].y.size(); ++k) {
+      if (!std::isfinite(series[i].y[k])) {
+        have_prev = false;
+        continue;
+      }
+      const cv::Point p = f.at(x[k], series[i].y[k]);
+      if (have_prev) cv::line(f.img, prev, p, c, 2, cv::LINE_AA);
+      cv::circle(f.img, p, 4, c, cv::FILLED, cv::LINE_AA);
+      prev = p;
+      have_prev = true;
+    }
+  }
+  legend(f, series);
+  save(path, f.img);
+}
+
+void plotBars(const std::string& path, const std::string& title, const std::string& y_label,
+              const std::vector<std::string>& labels, const std::vector<Series>& series,
+              double y_min, double y_max, double reference_line) {
+  const int n = static_cast<int>(labels.size());
+  const int w = std::max(700, 320 + n * std::max(18, 8 * static_cast<int>(series.size()) + 6));
+  // Plot area above, 260 px below it for the rotated group labels.
+  Frame a;
+  a.img = cv::Mat(840, w, CV_8UC3, kWhite);
+  a.box = cv::Rect(90, 50, w - 90 - 230, 840 - 50 - 260);
+  a.x0 = 0;
+  a.x1 = std::max(1, n);
+  a.y0 = y_min;
+  a.y1 = y_max;
+  cv::putText(a.img, title, {a.box.x, 30}, kFont, 0.7, kBlack, 2, cv::LINE_AA);
+  const double step = niceStep(y_max - y_min, 6);
+  for (double y = std::ceil(y_min / step) * step; y <= y_max + 1e-9; y += step) {
+    const cv::Point p = a.at(0, y);
+    cv::line(a.img, {a.box.x, p.y}, {a.box.x + a.box.width, p.y}, kGrey, 1);
+    cv::putText(a.img, num(y), {8, p.y + 5}, kFont, 0.45, kBlack, 1, cv::LINE_AA);
+  }
+  cv::putText(a.img, y_label, {8, a.box.y - 12}, kFont, 0.45, kBlack, 1, cv::LINE_AA);
+  const int ns = std::max<int>(1, static_cast<int>(series.size()));
+  for (int k = 0; k < n; ++k) {
+    for (int s = 0; s < static_cast<int>(series.size()); ++s) {
+      if (k >= static_cast<int>(series[s].y.size()) || !std::isfinite(series[s].y[k])) continue;
+      const double xl = k + 0.1 + 0.8 * s / ns, xr = k + 0.1 + 0.8 * (s + 1) / ns;
+      const double v = std::clamp(series[s].y[k], y_min, y_max);
+      cv::rectangle(a.img, a.at(xl, y_min), a.at(xr, v), kPalette[s % 8], cv::FILLED);
+    }
+    // Label rotated 90 degrees under the group.
+    cv::Mat lab(16, 250, CV_8UC3, kWhite);
+    cv::putText(lab, labels[k], {2, 12}, kFont, 0.38, kBlack, 1, cv::LINE_AA);
+    cv::Mat rot;
+    cv::rotate(lab, rot, cv::ROTATE_90_COUNTERCLOCKWISE);
+    const cv::Point base = a.at(k + 0.5, y_min);
+    const int x = std::clamp(base.x - 8, 0, a.img.cols - rot.cols);
+    rot.copyTo(a.img(cv::Rect(x, base.y + 4, rot.cols, rot.rows)));
+  }
+  if (reference_line > y_min && reference_line < y_max) {
+    const cv::Point p = a.at(0, reference_line);
+    cv::line(a.img, {a.box.x, p.y}, {a.box.x + a.box.width, p.y}, kBlack, 1, cv::LINE_AA);
+    cv::putText(a.img, "target " + num(reference_line), {a.box.x + a.box.width + 4, p.y + 4}, kFont,
+                0.4, kBlack, 1, cv::LINE_AA);
+  }
+  cv::rectangle(a.img, a.box, kBlack, 1);
+  legend(a, series);
+  save(path, a.img);
+}
+
+}  // namespace validation
+}  // namespace place_planner

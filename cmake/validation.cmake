@@ -48,4 +48,7 @@ if(CATKIN_ENABLE_TESTING)
   target_compile_definitions(validation_tests PRIVATE
     PP_SOURCE_DIR="${PP_VALIDATION_REAL_SOURCE_DIR}"
     PP_SHARED_DATA_DIR="${PP_VALIDATION_REAL_SOURCE_DIR}/../shared/data")
+  if(PP_VALIDATION_HAVE_PLANNER)
+    target_compile_definitions(validation_tests PRIVATE PP_VALIDATION_HAVE_PLANNER=1)
+  endif()
 endif()

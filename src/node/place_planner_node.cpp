@@ -47,6 +47,11 @@ Eigen::Isometry3d poseFromGoal(const geometry_msgs::Pose& pose, const std::strin
   return fromMsg(pose);
 }
 
+Mesh mappedBy(Mesh mesh, const Eigen::Isometry3d& X) {
+  if (X.matrix() == Eigen::Matrix4d::Identity()) return mesh;
+  return transformed(mesh, X.rotation(), X.translation());
+}
+
 const char* codeName(uint8_t code) {
   switch (code) {
     case Result::SUCCESS: return "SUCCESS";
@@ -148,16 +153,16 @@ PlacePlannerNode::Prepared PlacePlannerNode::prepare(const PlacePlanGoal& goal) 
   out.X_O1O = Eigen::Isometry3d::Identity();
   out.X_O1O.linear() = X_WO.rotation();
 
+  // Validated in the frame they came in (so an index or coordinate in a message names the element
+  // as sent), then mapped.
   std::vector<Eigen::Vector3d> vertices;
   std::vector<std::vector<int>> polygons;
   try {
     fromMsg(*object, "object mesh", &vertices, &polygons);
-    for (auto& v : vertices) v = X_OM * v;
-    out.object_O = buildMesh(vertices, polygons, "object mesh");
-    out.object = transformed(out.object_O, out.X_O1O.linear(), Eigen::Vector3d::Zero());
+    out.object_O = mappedBy(buildMesh(vertices, polygons, "object mesh"), X_OM);
+    out.object = mappedBy(out.object_O, out.X_O1O);
     fromMsg(*area, "placement area mesh", &vertices, &polygons);
-    for (auto& v : vertices) v = X_WA * v;
-    out.area_W = buildMesh(vertices, polygons, "placement area mesh");
+    out.area_W = mappedBy(buildMesh(vertices, polygons, "placement area mesh"), X_WA);
   } catch (const MeshError& e) {
     throw GoalError(Result::INVALID_MESH, e.what());
   }

@@ -48,9 +48,13 @@ int main(int argc, char** argv) {
   }
   try {
     const ros::Time stamp(1.0);  // bag time; rosbag play republishes with its own clock
+    // A connection header given to Bag::write replaces the generated one: it needs the type too.
     auto header = boost::make_shared<ros::M_string>();
     (*header)["callerid"] = "/make_demo_bag";
     (*header)["latching"] = "1";
+    (*header)["type"] = ros::message_traits::datatype<pcl_msgs::PolygonMesh>();
+    (*header)["md5sum"] = ros::message_traits::md5sum<pcl_msgs::PolygonMesh>();
+    (*header)["message_definition"] = ros::message_traits::definition<pcl_msgs::PolygonMesh>();
     rosbag::Bag bag(out, rosbag::bagmode::Write);
     for (const auto& [topic, name, frame] :
          {std::make_tuple("placement_area_mesh", area, area_frame),

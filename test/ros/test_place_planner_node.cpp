@@ -241,6 +241,7 @@ TEST(PlacePlannerNode, NanVertexIsInvalidMeshAndNodeKeepsServing) {
   EXPECT_EQ(bad.state, actionlib::SimpleClientGoalState::ABORTED);
   EXPECT_NE(bad.result.error_message.find("object mesh"), std::string::npos) << bad.result.error_message;
   EXPECT_NE(bad.result.error_message.find("vertex 5"), std::string::npos) << bad.result.error_message;
+  EXPECT_NE(bad.result.error_message.find("y = nan"), std::string::npos) << bad.result.error_message;
   EXPECT_TRUE(bad.result.candidates.empty());
 
   goal.object_mesh = meshMsg(testObject(), "");
@@ -448,7 +449,8 @@ TEST(PlacePlannerParams, OutOfRangeAndWrongTypeAreNamed) {
 }
 
 TEST(PlacePlannerParams, NodeRefusesToStartWithBadParameter) {
-  const std::string command = std::string(PP_NODE_BINARY) +
+  // `timeout`: should the node start after all, the test fails instead of hanging.
+  const std::string command = "timeout 20 " + std::string(PP_NODE_BINARY) +
                               " __name:=bad_place_planner _max_rotations:=99 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);

@@ -2,8 +2,9 @@
 // Private parameters: action (default /place_planner/place_plan), frame (world), object_x,
 // object_y, object_z (where the object's mesh frame is now, m), orientation_mode (""),
 // floor_point_spacing (0 = node default), max_candidates (0 = node default), print (5 rows),
-// timeout (s), status_file (optional: the exit status is written there, since roslaunch does
-// not report it). Exit status 0 when the answer is SUCCESS with a stable best candidate.
+// timeout (s), report_file (optional: the printed report is also written there, and its last
+// line is "status N" with the exit status, since roslaunch reports neither).
+// Exit status 0 when the answer is SUCCESS with a stable best candidate.
 #include <actionlib/client/simple_action_client.h>
 #include <ros/ros.h>
 
@@ -11,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
+#include <string>
 
 #include "place_planner/PlacePlanAction.h"
 #include "place_planner/ros/conversions.h"
@@ -32,6 +35,17 @@ const char* codeName(int code) {
   }
 }
 
+// printf into the report (stdout and, later, the report file).
+std::string g_report;
+template <typename... Args>
+void report(const char* format, Args... args) {
+  std::string text(std::snprintf(nullptr, 0, format, args...) + 1, '\0');
+  std::snprintf(text.data(), text.size(), format, args...);
+  text.pop_back();
+  std::fputs(text.c_str(), stdout);
+  g_report += text;
+}
+
 int run(ros::NodeHandle& pnh) {
   std::string action = "/place_planner/place_plan", frame = "world", mode;
   double x = 0, y = 0, z = 0.5, spacing = 0, timeout = 60;
@@ -49,7 +63,7 @@ int run(ros::NodeHandle& pnh) {
 
   actionlib::SimpleActionClient<place_planner::PlacePlanAction> client(action, true);
   if (!client.waitForServer(ros::Duration(timeout))) {
-    std::printf("demo_client: no action server %s\n", action.c_str());
+    report("demo_client: no action server %s\n", action.c_str());
     return 1;
   }
   place_planner::PlacePlanGoal goal;
@@ -69,7 +83,7 @@ int run(ros::NodeHandle& pnh) {
     client.sendGoal(goal);
     if (!client.waitForResult(ros::Duration(timeout))) {
       client.cancelGoal();
-      std::printf("demo_client: no result within %.0f s\n", timeout);
+      report("demo_client: no result within %.0f s\n", timeout);
       return 1;
     }
     result = client.getResult();
@@ -77,12 +91,12 @@ int run(ros::NodeHandle& pnh) {
     ros::WallDuration(0.5).sleep();
   }
 
-  std::printf("\nplace_planner: %s in %.3f s, %d floor points evaluated, %zu candidates%s%s\n",
+  report("\nplace_planner: %s in %.3f s, %d floor points evaluated, %zu candidates%s%s\n",
               codeName(result->error_code), result->planning_time, result->floor_points_evaluated,
               result->candidates.size(), result->error_message.empty() ? "" : "\n  ",
               result->error_message.c_str());
   if (!result->candidates.empty()) {
-    std::printf("rank  Q      stable  position in %s (m)        roll/pitch/yaw (deg)     contacts\n",
+    report("rank  Q      stable  position in %s (m)        roll/pitch/yaw (deg)     contacts\n",
                 frame.c_str());
   }
   for (size_t i = 0; i < result->candidates.size() && static_cast<int>(i) < rows; ++i) {
@@ -90,7 +104,7 @@ int run(ros::NodeHandle& pnh) {
     const Eigen::Isometry3d X = place_planner::fromMsg(c.pose.pose);
     const Eigen::Vector3d ypr = X.rotation().eulerAngles(2, 1, 0) * 180.0 / M_PI;
     const Eigen::Vector3d p = X.translation();
-    std::printf("#%-3zu  %.3f  %-6s  (%7.3f, %7.3f, %7.3f)   (%6.1f, %6.1f, %6.1f)   %zu\n", i + 1,
+    report("#%-3zu  %.3f  %-6s  (%7.3f, %7.3f, %7.3f)   (%6.1f, %6.1f, %6.1f)   %zu\n", i + 1,
                 c.quality, c.stable ? "yes" : "no", p.x(), p.y(), p.z(), ypr[2], ypr[1], ypr[0],
                 c.contact_points.size());
   }
@@ -108,9 +122,9 @@ int main(int argc, char** argv) {
   ros::AsyncSpinner spinner(1);
   spinner.start();
   const int status = run(pnh);
-  std::string status_file;
-  if (pnh.getParam("status_file", status_file) && !status_file.empty()) {
-    std::ofstream(status_file) << status << "\n";
+  std::string report_file;
+  if (pnh.getParam("report_file", report_file) && !report_file.empty()) {
+    std::ofstream(report_file) << g_report << "status " << status << "\n";
   }
   return status;
 }

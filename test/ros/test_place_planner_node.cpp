@@ -321,6 +321,26 @@ TEST(PlacePlannerNode, CancelEndsGoalQuicklyWithCandidatesSoFar) {
   }
 }
 
+// ---------------------------------------------------------------- 5b
+TEST(PlacePlannerNode, NewGoalPreemptsRunningOne) {
+  FeedbackLog log;
+  sendWithFeedback(longGoal(), &log);
+  for (int i = 0; i < 200 && log.copy().empty(); ++i) ros::WallDuration(0.01).sleep();
+  ASSERT_EQ(client().getState(), actionlib::SimpleClientGoalState::ACTIVE);
+  // A second caller with a quick goal.
+  Client other(kAction, true);
+  ASSERT_TRUE(other.waitForServer(ros::Duration(10.0)));
+  PlacePlanGoal goal = quickGoal();
+  goal.object_mesh = meshMsg(testObject(), "");
+  goal.placement_area_mesh = meshMsg(testArea(), "world");
+  other.sendGoal(goal);
+  ASSERT_TRUE(client().waitForResult(ros::Duration(5.0)));
+  EXPECT_EQ(client().getState(), actionlib::SimpleClientGoalState::PREEMPTED);
+  EXPECT_EQ(client().getResult()->error_code, Result::PREEMPTED);
+  ASSERT_TRUE(other.waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(other.getResult()->error_code, Result::SUCCESS) << other.getResult()->error_message;
+}
+
 // ---------------------------------------------------------------- 6
 TEST(PlacePlannerNode, FeedbackDuringLongPlanAndDocumentedMarkers) {
   FeedbackLog log;

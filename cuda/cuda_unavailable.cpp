@@ -18,3 +18,13 @@ void transformVertices(const Rigid&, const V3*, V3*, size_t) {
 
 }  // namespace cuda
 }  // namespace place_planner
+
+#include "place_planner/backend.h"
+
+namespace place_planner {
+
+std::unique_ptr<Backend> makeCudaBackend(const ObjectModel&, const AreaModel&, const TiltParams&) {
+  throw std::runtime_error("CUDA backend unavailable: place_planner was built without CUDA");
+}
+
+}  // namespace place_planner

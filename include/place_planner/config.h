@@ -2,6 +2,7 @@
 // config/place_planner.yaml mirrors it field for field; validate() names a bad field.
 #pragma once
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <string>
 
 namespace place_planner {
@@ -29,6 +30,9 @@ struct PlannerConfig {
   int max_candidates = 10;                   // after ranking and merging
   int threads = 0;                           // 0 = all hardware threads
   int max_local_optimisation_steps = 4;      // slides/rotations per leaf (Section VI)
+  double min_tipping_angle_deg = 12.0;       // stable needs at least this tilt to tip over
+  // Start orientation R_WO of the object (mode keep uses it; the others rotate it minimally).
+  Eigen::Quaterniond start_orientation = Eigen::Quaterniond::Identity();
   double min_quality = 0.0;                  // candidates below are dropped
   double merge_distance = 0.005;             // m, poses closer than this ...
   double merge_angle_deg = 3.0;              // ... and this are one candidate

@@ -30,6 +30,7 @@ struct Candidate {
 };
 
 struct StepTimes {  // wall time per batched step, ms
+  double setup = 0;  // sphere models, BVHs, height grid
   double floor_points = 0, first_contact = 0, contact_points = 0, tilt_vertex = 0, tilt_edge = 0,
          stability = 0, local_optimisation = 0;
 };

@@ -48,6 +48,11 @@ void validate(const PlannerConfig& c) {
   require(c.threads >= 0 && c.threads <= 256, "threads", c.threads, "0 .. 256, 0 = all");
   require(c.max_local_optimisation_steps >= 0 && c.max_local_optimisation_steps <= 50,
           "max_local_optimisation_steps", c.max_local_optimisation_steps, "0 .. 50");
+  require(std::isfinite(c.min_tipping_angle_deg) && c.min_tipping_angle_deg >= 0 &&
+              c.min_tipping_angle_deg < 90,
+          "min_tipping_angle_deg", c.min_tipping_angle_deg, "0 .. 90");
+  require(std::abs(c.start_orientation.norm() - 1.0) < 1e-3, "start_orientation",
+          c.start_orientation.norm(), "a unit quaternion");
   require(std::isfinite(c.min_quality) && c.min_quality <= 1, "min_quality", c.min_quality, "<= 1");
   require(std::isfinite(c.merge_distance) && c.merge_distance >= 0, "merge_distance",
           c.merge_distance, ">= 0");

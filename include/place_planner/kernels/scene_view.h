@@ -1,0 +1,44 @@
+// Raw-pointer views of the prepared scene, valid on the host or (with device pointers) in
+// CUDA kernels. Built from scene.h models by view(); the CUDA backend uploads the arrays and
+// fills the same structs with device pointers.
+#pragma once
+#include "place_planner/bvh.h"
+
+namespace place_planner {
+
+struct MeshView {
+  const V3* vertices;
+  const int* triangles;  // 3 per triangle
+  const int* edges;      // 2 per edge
+  const V3* triangle_normals;
+  int num_vertices, num_triangles, num_edges;
+  BvhView triangle_bvh, edge_bvh, vertex_bvh;
+  const V3* sphere_centres;
+  const V3* sphere_normals;
+  int num_spheres;
+  double sphere_radius;
+  BvhView sphere_bvh;
+  Aabb bounds;
+};
+
+struct GridView {
+  double x0, y0, cell;
+  int nx, ny;
+  double collision_distance;
+  const int* start;
+  const int* items;
+  const double* max_z;
+};
+
+struct ObjectView {
+  MeshView mesh;  // frame O
+  V3 com;         // c_O in O
+  double bounding_radius;
+};
+
+struct AreaView {
+  MeshView mesh;  // frame G
+  GridView grid;
+};
+
+}  // namespace place_planner

@@ -1,0 +1,28 @@
+// Support polygon geometry and the quality measure Q (Section VI). 2D, in the plane P of the
+// contacts (or the plane perpendicular to gravity for the projected support).
+#pragma once
+#include <Eigen/Core>
+#include <vector>
+
+namespace place_planner {
+
+// Convex hull, counter-clockwise, no collinear points (Andrew's monotone chain). Fewer than 3
+// distinct non-collinear points give a degenerate hull (size < 3).
+std::vector<Eigen::Vector2d> convexHull2d(std::vector<Eigen::Vector2d> pts);
+double polygonArea(const std::vector<Eigen::Vector2d>& hull);
+Eigen::Vector2d polygonCentroid(const std::vector<Eigen::Vector2d>& hull);  // c_Omega
+// Signed distance of p from the hull's boundary: > 0 inside, < 0 outside.
+double signedBoundaryDistance(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& p);
+// l_Omega: distance from `from` (inside) to the boundary along unit `dir`.
+double boundaryDistanceAlong(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& from,
+                             const Eigen::Vector2d& dir);
+
+// Q = 1 - d(c^_O, c^_Omega) / l^_Omega - s / (1 + s),  s = (h / sqrt(A(Omega)))^2 / 4.
+// The paper's second term d(c_O, Omega) / A(Omega) divides a length by an area; we use the
+// dimensionless height-to-footprint ratio h / sqrt(A) instead, squashed into [0, 1) so that
+// Q <= 1 with Q = 1 only for a centred footprint of an object lying flat (h -> 0), a cube
+// resting on a face scores 1 - 1/17 = 0.94, and tall narrow footprints fall below 0.3.
+// c_hat_O: projected centre of mass; h: height of c_O above the plane. Degenerate hull: -1.
+double quality(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& c_hat_O, double h);
+
+}  // namespace place_planner

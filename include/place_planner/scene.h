@@ -1,0 +1,75 @@
+// The prepared planning scene: both meshes as flat arrays with their BVHs and sphere models,
+// and the area's 2D height grid. Frames: the object model is in O (the object mesh frame);
+// the area model is in G, the planning frame W rotated so that gravity is -z (R_GW), which
+// makes the grid of Section V-B axis-aligned in x/y.
+#pragma once
+#include <Eigen/Geometry>
+#include <array>
+#include <vector>
+
+#include "place_planner/bvh.h"
+#include "place_planner/mesh.h"
+
+namespace place_planner {
+
+struct SphereModel {  // Section V-B: centres 2r apart on every patch
+  double radius = 0.0;
+  std::vector<V3> centres;
+  std::vector<V3> normals;  // unit normal of the patch each sphere was sampled on
+  Bvh bvh;                  // over the centres, leaves sorted by index
+};
+
+// Height grid (Section V-B): each cell lists the area spheres whose virtual sphere of radius
+// `collision distance` overlaps it, and the maximum z of those spheres plus that distance.
+struct HeightGrid {
+  double x0 = 0, y0 = 0, cell = 1;
+  int nx = 0, ny = 0;
+  double collision_distance = 0;
+  std::vector<int> start;    // nx * ny + 1 offsets into items
+  std::vector<int> items;    // area sphere indices
+  std::vector<double> max_z; // per cell; -inf when empty
+};
+
+struct MeshModel {
+  std::vector<V3> vertices;
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<std::array<int, 2>> edges;
+  std::vector<V3> triangle_normals;
+  Bvh triangle_bvh, edge_bvh, vertex_bvh;
+  SphereModel spheres;
+  Aabb bounds;
+};
+
+struct ObjectModel : MeshModel {  // frame O
+  V3 com;                  // c_O
+  double bounding_radius;  // about c_O
+  Eigen::Matrix3d principal_axes;
+};
+
+struct AreaModel : MeshModel {  // frame G
+  HeightGrid grid;
+  Eigen::Matrix3d R_GW;  // rotation from the planning frame W into G
+};
+
+MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius);
+ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius);
+AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
+                         double collision_distance, double grid_cell);
+
+// Samples sphere centres 2r apart on each triangle, its edges and vertices (sphere_model.cpp).
+SphereModel sampleSpheres(const std::vector<V3>& vertices,
+                          const std::vector<std::array<int, 3>>& triangles,
+                          const std::vector<std::array<int, 2>>& edges, double radius);
+
+HeightGrid buildHeightGrid(const SphereModel& area_spheres, const Aabb& area_bounds,
+                           double collision_distance, double cell);
+
+// Rotation taking -gravity to +z (the G frame), with a deterministic choice about z.
+Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W);
+
+inline V3 toV3(const Eigen::Vector3d& p) { return v3(p.x(), p.y(), p.z()); }
+inline Eigen::Vector3d toEigen(V3 p) { return Eigen::Vector3d(p.x, p.y, p.z); }
+Rigid toRigid(const Eigen::Isometry3d& T);
+Eigen::Isometry3d toIsometry(const Rigid& T);
+
+}  // namespace place_planner

@@ -1,0 +1,389 @@
+// Orchestration of the paper's method (Sections IV-VI): every tree of every floor point advances
+// together, one batched step at a time (Section VII-C), through the Backend interface.
+#include "place_planner/planner.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+
+#include "place_planner/backend.h"
+#include "place_planner/contact_points.h"
+#include "place_planner/cuda_backend.h"
+#include "place_planner/floor_points.h"
+#include "place_planner/local_optimisation.h"
+#include "place_planner/parallel_for.h"
+#include "place_planner/penetration.h"
+#include "place_planner/pre_orientation.h"
+#include "place_planner/stability.h"
+#include "place_planner/tilt_axis.h"
+
+namespace place_planner {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Rotation by `angle` about the axis (s, d) applied after X.
+Rigid rotated(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector3d& d, double angle) {
+  Eigen::Isometry3d T = toIsometry(X);
+  Eigen::Isometry3d Rot = Eigen::Isometry3d::Identity();
+  Rot.linear() = Eigen::AngleAxisd(angle, d.normalized()).toRotationMatrix();
+  Rot.translation() = s - Rot.linear() * s;
+  return toRigid(Rot * T);
+}
+
+Rigid translated(Rigid X, const V3& d) {
+  X.t = X.t + d;
+  return X;
+}
+
+struct Node {
+  Rigid X;
+  int root = 0;
+  int depth = 0;  // rotations of the tree (Section V-C)
+  int opt = 0;    // local optimisation steps (Section VI)
+  std::vector<Rigid> path;
+  std::vector<V3> pending;  // translations still to do, directions
+  std::vector<double> pending_tmax;
+  // Rotation request.
+  Eigen::Vector3d s_A, d_A;
+  bool both_directions = true;
+  bool local_rotation = false;
+  std::vector<ContactPoint> contacts;
+};
+
+struct Leaf {
+  Rigid X;
+  int root;
+  bool stable;
+  double quality;
+  std::vector<ContactPoint> contacts;
+  std::vector<Rigid> path;
+};
+
+// A direction is blocked when a contact away from the axis would move into the area.
+bool blocked(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& s,
+             const Eigen::Vector3d& d, int sigma, double lever_tol) {
+  for (const auto& c : contacts) {
+    const Eigen::Vector3d r = c.p_W - s;
+    const Eigen::Vector3d v = sigma * d.cross(r);
+    if (v.norm() < lever_tol) continue;  // on the axis
+    if (v.normalized().dot(c.n_W) < -0.3) return true;
+  }
+  return false;
+}
+
+double angleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a.transpose() * b).angle();
+}
+
+std::once_flag g_backend_log;
+
+}  // namespace
+
+PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConfig& config,
+                         const ProgressCallback& progress) const {
+  validate(config);
+  if (object.empty()) throw std::invalid_argument("object mesh is empty");
+  if (area.empty()) throw std::invalid_argument("placement area mesh is empty");
+  const auto t0 = Clock::now();
+  PlanResult result;
+  PlanStats& st = result.stats;
+
+  // ------------------------------------------------------------------ frames and models
+  const Eigen::Vector3d d_g_W = config.gravity.normalized();
+  const Eigen::Vector3d d_vis_W =
+      config.approach.norm() > 1e-9 ? Eigen::Vector3d(config.approach.normalized()) : d_g_W;
+  const double R_obj = object.properties.bounding_radius;
+  // Sphere radius: about 1% of the object's size, within 0.75 .. 4 mm (Section V-B).
+  const double r = config.sphere_radius > 0 ? config.sphere_radius
+                                            : std::clamp(0.01 * 2.0 * R_obj, 0.00075, 0.004);
+  const double cd = 2.0 * r;  // collision distance: sum of both radii
+  const double cell = config.grid_cell_size > 0 ? config.grid_cell_size : cd;
+  st.sphere_radius = r;
+  auto tp = Clock::now();
+  const ObjectModel om = buildObjectModel(object, r);
+  const AreaModel am = buildAreaModel(area, d_g_W, r, cd, cell);
+  const Eigen::Matrix3d R_GW = am.R_GW;
+  st.steps.setup = msSince(tp);
+  const V3 d_vis = toV3(R_GW * d_vis_W);
+  const V3 d_g = v3(0, 0, -1);
+
+  std::unique_ptr<Backend> backend;
+  TiltParams tilt{0.002, 1e-6 + 1e-4 * r};
+  if (config.backend != BackendKind::kCpu) {
+    std::string why;
+    if (cuda::available(&why)) {
+      backend = makeCudaBackend(om, am, tilt);
+    } else if (config.backend == BackendKind::kCuda) {
+      throw std::runtime_error("backend = cuda requested but unavailable: " + why);
+    } else {
+      std::call_once(g_backend_log, [&] {
+        std::fprintf(stderr, "[place_planner] no usable GPU (%s): using the CPU backend\n", why.c_str());
+      });
+    }
+  }
+  if (!backend) backend = makeCpuBackend(om, am, tilt, config.threads);
+  st.backend = backend->name();
+
+  // ------------------------------------------------------------------ floor points (IV-B)
+  tp = Clock::now();
+  FloorPointParams fpp;
+  fpp.d_vis = d_vis;
+  fpp.spacing = config.floor_point_spacing;
+  fpp.min_points = config.min_floor_points;
+  fpp.lowest_n = config.lowest_n;
+  if (config.hasRegion()) {
+    // The region is a box in W; test hits against it in W by mapping G back.
+    fpp.has_region = false;
+  }
+  FloorPoints fp = floorPoints(am, fpp);
+  if (config.hasRegion()) {
+    std::vector<V3> kept;
+    for (const V3& p : fp.points) {
+      const Eigen::Vector3d pw = R_GW.transpose() * toEigen(p);
+      if ((pw.array() >= config.region_min.array()).all() && (pw.array() <= config.region_max.array()).all())
+        kept.push_back(p);
+    }
+    fp.points = kept;
+  }
+  for (const V3& p : fp.points) result.floor_points_W.push_back(R_GW.transpose() * toEigen(p));
+  st.steps.floor_points = msSince(tp);
+
+  // ------------------------------------------------------------------ orientations (IV-A)
+  const Eigen::Matrix3d R_start = R_GW * config.start_orientation.normalized().toRotationMatrix();
+  const std::vector<Eigen::Matrix3d> orientations =
+      preOrientations(object.properties, R_start, toEigen(d_vis), config.orientation);
+
+  // Height of the area along -d_vis, to start every object clear of it (V-A, first step).
+  double hmax = -kInf, hmin = kInf;
+  for (const V3& v : am.vertices) {
+    hmax = std::max(hmax, -dot(v, d_vis));
+    hmin = std::min(hmin, -dot(v, d_vis));
+  }
+  const double diag = norm(am.bounds.hi - am.bounds.lo);
+
+  const int num_roots = static_cast<int>(fp.points.size() * orientations.size());
+  st.floor_points_total = static_cast<int>(fp.points.size());
+  const StabilityParams sp{config.friction, 1.5 * cd, config.min_tipping_angle_deg * M_PI / 180.0};
+  const int max_opt = config.max_local_optimisation_steps;
+  std::vector<Leaf> leaves;
+  double best_q = 0;
+  int stable_count = 0;
+  auto report = [&]() -> bool {
+    if (config.time_budget_ms > 0 && msSince(t0) > config.time_budget_ms) {
+      result.timed_out = true;
+      return false;
+    }
+    if (!progress) return true;
+    Progress p;
+    p.floor_points_done = st.floor_points_done;
+    p.floor_points_total = st.floor_points_total;
+    p.best_quality = best_q;
+    p.candidates = stable_count;
+    p.elapsed_ms = msSince(t0);
+    if (!progress(p)) {
+      result.cancelled = true;
+      return false;
+    }
+    return true;
+  };
+
+  // Roots are processed in groups so good poses appear early (anytime behaviour).
+  const int group = std::max(8, 4 * resolveThreads(config.threads));
+  bool stop = !report();
+  for (int g0 = 0; g0 < num_roots && !stop; g0 += group) {
+    std::vector<Node> translate, contact, rotating;
+    for (int k = g0; k < std::min(num_roots, g0 + group); ++k) {
+      const int f = k / static_cast<int>(orientations.size());
+      const Eigen::Matrix3d& R = orientations[k % orientations.size()];
+      const V3 p_f = fp.points[f];
+      // Centre of mass above the floor point along -d_vis, clear of everything (V-A).
+      const double h = hmax + dot(p_f, d_vis) + R_obj + 0.01;
+      const Eigen::Vector3d com_G = toEigen(p_f) - h * toEigen(d_vis);
+      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+      X.linear() = R;
+      X.translation() = com_G - R * object.properties.center_of_mass;
+      Node n;
+      n.X = toRigid(X);
+      n.root = k;
+      n.path.push_back(n.X);  // pre-placement pose
+      n.pending.push_back(d_vis);
+      n.pending_tmax.push_back(h + R_obj + (hmax - hmin) + 0.01);
+      translate.push_back(std::move(n));
+    }
+    while (!translate.empty() || !contact.empty() || !rotating.empty()) {
+      // -------------------------------------------------------------- distance kernel (V-A)
+      if (!translate.empty()) {
+        tp = Clock::now();
+        std::vector<TranslationQuery> q;
+        for (const Node& n : translate) q.push_back({n.X, n.pending.front(), n.pending_tmax.front()});
+        std::vector<double> t;
+        backend->distance(q, t);
+        std::vector<Node> again;
+        for (size_t i = 0; i < translate.size(); ++i) {
+          Node& n = translate[i];
+          if (t[i] >= kInf) continue;  // nothing below: the object would fall off the area
+          n.X = translated(n.X, t[i] * n.pending.front());
+          n.path.push_back(n.X);
+          n.pending.erase(n.pending.begin());
+          n.pending_tmax.erase(n.pending_tmax.begin());
+          (n.pending.empty() ? contact : again).push_back(std::move(n));
+        }
+        translate.swap(again);
+        st.steps.first_contact += msSince(tp);
+      }
+      // -------------------------------------------------------------- contact kernel (V-B)
+      if (!contact.empty()) {
+        tp = Clock::now();
+        std::vector<Rigid> X;
+        for (const Node& n : contact) X.push_back(n.X);
+        std::vector<std::vector<SphereContact>> raw;
+        backend->contactPoints(X, raw);
+        st.steps.contact_points += msSince(tp);
+        tp = Clock::now();
+        st.tree_nodes += static_cast<long>(contact.size());
+        for (size_t i = 0; i < contact.size(); ++i) {
+          Node& n = contact[i];
+          n.contacts = reduceContacts(raw[i], cd);
+          const Eigen::Vector3d com = toEigen(apply(n.X, om.com));
+          const Stability s = evaluateStability(n.contacts, com, sp);
+          const Eigen::Vector3d k1 = toEigen(rotate(n.X, toV3(om.principal_axes.col(0))));
+          const TiltAxis axis = tiltAxis(n.contacts, com, k1, toEigen(d_g), 1.5 * cd, n.root + 7919u * n.depth);
+          auto leaf = [&](bool stable) {
+            leaves.push_back(Leaf{n.X, n.root, stable, s.quality, n.contacts, n.path});
+            if (stable) {
+              if (stable_count++ == 0) st.first_stable_ms = msSince(t0);
+              best_q = std::max(best_q, s.quality);
+            }
+          };
+          if (n.contacts.empty()) continue;
+          if (s.stable) {
+            leaf(true);
+          } else if ((axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear) &&
+                     n.depth < config.max_rotations) {
+            n.s_A = axis.s_A;
+            n.d_A = axis.d_A;
+            n.both_directions = true;
+            n.local_rotation = false;
+            rotating.push_back(std::move(n));
+          } else if (n.opt < max_opt) {
+            const auto tl = Clock::now();
+            const LocalStep step = localOptimisationStep(s, cd);
+            st.steps.local_optimisation += msSince(tl);
+            if (step.kind == LocalStep::kSlide) {
+              ++n.opt;
+              n.X = translated(n.X, toV3(step.lift));
+              n.path.push_back(n.X);
+              n.pending = {toV3(step.slide), d_g};
+              n.pending_tmax = {0.5 * diag, diag};
+              translate.push_back(std::move(n));
+            } else if (step.kind == LocalStep::kRotate) {
+              ++n.opt;
+              n.s_A = step.s_A;
+              n.d_A = step.d_A;
+              n.both_directions = false;
+              n.local_rotation = true;
+              rotating.push_back(std::move(n));
+            } else {
+              leaf(false);
+            }
+          } else {
+            leaf(false);
+          }
+        }
+        contact.clear();
+        st.steps.stability += msSince(tp);
+      }
+      // -------------------------------------------------------------- rotation kernels (V-C)
+      if (!rotating.empty()) {
+        std::vector<RotationQuery> q;
+        for (const Node& n : rotating) q.push_back({n.X, toV3(n.s_A), toV3(n.d_A)});
+        std::vector<AnglePair> av, ae;
+        tp = Clock::now();
+        backend->vertexSurfaceRotation(q, av);
+        st.steps.tilt_vertex += msSince(tp);
+        tp = Clock::now();
+        backend->edgeEdgeRotation(q, ae);
+        st.steps.tilt_edge += msSince(tp);
+        for (size_t i = 0; i < rotating.size(); ++i) {
+          const Node& n = rotating[i];
+          for (int sigma : {1, -1}) {
+            if (sigma < 0 && !n.both_directions) continue;
+            const double a = sigma > 0 ? std::min(av[i].ccw, ae[i].ccw) : std::min(av[i].cw, ae[i].cw);
+            if (a >= kInf) continue;  // turns freely: no resting pose that way
+            if (blocked(n.contacts, n.s_A, n.d_A, sigma, 0.5 * cd)) continue;
+            Node c;
+            c.X = rotated(n.X, n.s_A, n.d_A, sigma * a);
+            c.root = n.root;
+            c.depth = n.depth + (n.local_rotation ? 0 : 1);
+            c.opt = n.opt;
+            c.path = n.path;
+            c.path.push_back(c.X);
+            contact.push_back(std::move(c));
+          }
+        }
+        rotating.clear();
+      }
+      if (!report()) {
+        stop = true;
+        break;
+      }
+    }
+    st.floor_points_done = std::min(num_roots, g0 + group) / static_cast<int>(orientations.size());
+    if (!stop && !report()) stop = true;
+  }
+
+  // ------------------------------------------------------------------ candidates
+  std::vector<size_t> order(leaves.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  // Penetration guard: a stable leaf whose object vertices lie inside the area by more than
+  // the sphere radius is not returned as stable.
+  for (Leaf& l : leaves)
+    if (l.stable && penetrationDepth(om, am, l.X) > r) l.stable = false;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    if (leaves[a].stable != leaves[b].stable) return leaves[a].stable;
+    if (leaves[a].quality != leaves[b].quality) return leaves[a].quality > leaves[b].quality;
+    return leaves[a].root < leaves[b].root;
+  });
+  const Eigen::Matrix3d R_WG = R_GW.transpose();
+  const double merge_angle = config.merge_angle_deg * M_PI / 180.0;
+  for (size_t idx : order) {
+    const Leaf& l = leaves[idx];
+    if (l.quality < config.min_quality) continue;
+    Candidate c;
+    Eigen::Isometry3d X_GO = toIsometry(l.X);
+    c.X_WO.linear() = R_WG * X_GO.linear();
+    c.X_WO.translation() = R_WG * X_GO.translation();
+    bool dup = false;
+    for (const Candidate& k : result.candidates)
+      if ((k.X_WO.translation() - c.X_WO.translation()).norm() < config.merge_distance &&
+          angleBetween(k.X_WO.linear(), c.X_WO.linear()) < merge_angle) {
+        dup = true;
+        break;
+      }
+    if (dup) continue;
+    c.quality = l.quality;
+    c.stable = l.stable;
+    for (const auto& p : l.contacts) c.contacts.push_back({R_WG * p.p_W, R_WG * p.n_W});
+    c.floor_point_W = result.floor_points_W[l.root / orientations.size()];
+    for (const Rigid& X : l.path) {
+      const Eigen::Isometry3d T = toIsometry(X);
+      Eigen::Isometry3d W = Eigen::Isometry3d::Identity();
+      W.linear() = R_WG * T.linear();
+      W.translation() = R_WG * T.translation();
+      c.intermediate_poses.push_back(W);
+    }
+    result.candidates.push_back(std::move(c));
+    if (static_cast<int>(result.candidates.size()) >= config.max_candidates) break;
+  }
+  st.total_ms = msSince(t0);
+  return result;
+}
+
+}  // namespace place_planner

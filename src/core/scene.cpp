@@ -1,0 +1,83 @@
+#include "place_planner/scene.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+
+namespace place_planner {
+
+Rigid toRigid(const Eigen::Isometry3d& T) {
+  Rigid r;
+  for (int i = 0; i < 9; ++i) r.R[i] = T.linear()(i / 3, i % 3);
+  r.t = toV3(T.translation());
+  return r;
+}
+
+Eigen::Isometry3d toIsometry(const Rigid& r) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 9; ++i) T.linear()(i / 3, i % 3) = r.R[i];
+  T.translation() = toEigen(r.t);
+  return T;
+}
+
+Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W) {
+  // Minimal rotation taking -d_g to +z; identity for the default d_g = -z.
+  const Eigen::Vector3d up = -gravity_W.normalized();
+  return Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius) {
+  MeshModel m;
+  m.vertices.reserve(mesh.vertices.size());
+  m.bounds = aabbEmpty();
+  for (const auto& v : mesh.vertices) {
+    m.vertices.push_back(toV3(R * v));
+    aabbAdd(m.bounds, m.vertices.back());
+  }
+  m.triangles = mesh.triangles;
+  m.edges = mesh.edges;
+  std::vector<Aabb> tri_boxes, edge_boxes, vert_boxes;
+  tri_boxes.reserve(m.triangles.size());
+  for (const auto& t : m.triangles) {
+    Aabb b = aabbEmpty();
+    for (int k = 0; k < 3; ++k) aabbAdd(b, m.vertices[t[k]]);
+    tri_boxes.push_back(b);
+    m.triangle_normals.push_back(normalized(
+        cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]])));
+  }
+  for (const auto& e : m.edges) {
+    Aabb b = aabbEmpty();
+    aabbAdd(b, m.vertices[e[0]]);
+    aabbAdd(b, m.vertices[e[1]]);
+    edge_boxes.push_back(b);
+  }
+  for (const auto& v : m.vertices) vert_boxes.push_back(Aabb{v, v});
+  m.triangle_bvh = buildBvh(tri_boxes);
+  m.edge_bvh = buildBvh(edge_boxes);
+  m.vertex_bvh = buildBvh(vert_boxes);
+  m.spheres = sampleSpheres(m.vertices, m.triangles, m.edges, sphere_radius);
+  std::vector<Aabb> sphere_boxes;
+  sphere_boxes.reserve(m.spheres.centres.size());
+  for (const V3& c : m.spheres.centres) sphere_boxes.push_back(Aabb{c, c});
+  m.spheres.bvh = buildBvh(sphere_boxes, 8);
+  return m;
+}
+
+ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius) {
+  ObjectModel o;
+  static_cast<MeshModel&>(o) = buildMeshModel(object_O, Eigen::Matrix3d::Identity(), sphere_radius);
+  o.com = toV3(object_O.properties.center_of_mass);
+  o.bounding_radius = object_O.properties.bounding_radius;
+  o.principal_axes = object_O.properties.principal_axes;
+  return o;
+}
+
+AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
+                         double collision_distance, double grid_cell) {
+  AreaModel a;
+  a.R_GW = gravityFrame(gravity_W);
+  static_cast<MeshModel&>(a) = buildMeshModel(area_W, a.R_GW, sphere_radius);
+  a.grid = buildHeightGrid(a.spheres, a.bounds, collision_distance, grid_cell);
+  return a;
+}
+
+}  // namespace place_planner

@@ -1,0 +1,108 @@
+// Surface sphere models and the 2D height grid (Section V-B).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "place_planner/scene.h"
+
+namespace place_planner {
+
+SphereModel sampleSpheres(const std::vector<V3>& vertices,
+                          const std::vector<std::array<int, 3>>& triangles,
+                          const std::vector<std::array<int, 2>>& edges, double radius) {
+  SphereModel m;
+  m.radius = radius;
+  const double step = 2.0 * radius;  // "the distance between two sphere centres is 2r"
+  std::vector<V3> vnormal(vertices.size(), v3(0, 0, 0));
+  for (const auto& t : triangles) {
+    const V3 a = vertices[t[0]], b = vertices[t[1]], c = vertices[t[2]];
+    const V3 n = cross(b - a, c - a);  // area-weighted
+    for (int k = 0; k < 3; ++k) vnormal[t[k]] = vnormal[t[k]] + n;
+    const double nn = norm(n);
+    if (nn <= 0) continue;
+    const V3 nu = (1.0 / nn) * n;
+    // Interior lattice in the triangle's plane, offset half a step from the first edge.
+    const V3 u = normalized(b - a);
+    const V3 w = cross(nu, u);
+    double umin = 0, umax = 0, wmin = 0, wmax = 0;
+    for (V3 p : {b - a, c - a}) {
+      umin = std::min(umin, dot(p, u));
+      umax = std::max(umax, dot(p, u));
+      wmin = std::min(wmin, dot(p, w));
+      wmax = std::max(wmax, dot(p, w));
+    }
+    for (double x = umin + 0.5 * step; x < umax; x += step) {
+      for (double y = wmin + 0.5 * step; y < wmax; y += step) {
+        const V3 p = a + x * u + y * w;
+        // Keep lattice points at least half a step inside: the edges get their own samples.
+        if (insideTriangle(p, a, b, c, -0.5 * step)) {
+          m.centres.push_back(p);
+          m.normals.push_back(nu);
+        }
+      }
+    }
+    // Triangles too small for a lattice point still get their centroid.
+    if (nn * 0.5 < step * step) {
+      m.centres.push_back((1.0 / 3.0) * (a + b + c));
+      m.normals.push_back(nu);
+    }
+  }
+  // Edges (sharp features are typical contacts) and vertices, once each.
+  for (const auto& e : edges) {
+    const V3 a = vertices[e[0]], b = vertices[e[1]];
+    const double len = norm(b - a);
+    const int n = static_cast<int>(std::floor(len / step));
+    const V3 en = normalized(vnormal[e[0]] + vnormal[e[1]]);
+    for (int i = 1; i <= n; ++i) {
+      const double s = i / static_cast<double>(n + 1);
+      m.centres.push_back(a + s * (b - a));
+      m.normals.push_back(en);
+    }
+  }
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    if (norm2(vnormal[i]) == 0) continue;  // unreferenced vertex
+    m.centres.push_back(vertices[i]);
+    m.normals.push_back(normalized(vnormal[i]));
+  }
+  return m;
+}
+
+HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, double cell) {
+  HeightGrid g;
+  g.collision_distance = cd;
+  g.cell = cell;
+  g.x0 = bounds.lo.x - cd;
+  g.y0 = bounds.lo.y - cd;
+  g.nx = std::max(1, static_cast<int>(std::ceil((bounds.hi.x - bounds.lo.x + 2 * cd) / cell)));
+  g.ny = std::max(1, static_cast<int>(std::ceil((bounds.hi.y - bounds.lo.y + 2 * cd) / cell)));
+  const size_t ncell = static_cast<size_t>(g.nx) * g.ny;
+  g.max_z.assign(ncell, -std::numeric_limits<double>::infinity());
+  std::vector<int> count(ncell, 0);
+  auto forCells = [&](const V3& c, auto&& f) {
+    // Cells meeting the virtual sphere's x/y disc (radius cd): the covering square of cells.
+    const int ix0 = std::max(0, static_cast<int>(std::floor((c.x - cd - g.x0) / cell)));
+    const int ix1 = std::min(g.nx - 1, static_cast<int>(std::floor((c.x + cd - g.x0) / cell)));
+    const int iy0 = std::max(0, static_cast<int>(std::floor((c.y - cd - g.y0) / cell)));
+    const int iy1 = std::min(g.ny - 1, static_cast<int>(std::floor((c.y + cd - g.y0) / cell)));
+    for (int iy = iy0; iy <= iy1; ++iy)
+      for (int ix = ix0; ix <= ix1; ++ix) {
+        // Distance from the centre to the cell rectangle, in x/y.
+        const double dx = std::max({0.0, g.x0 + ix * cell - c.x, c.x - (g.x0 + (ix + 1) * cell)});
+        const double dy = std::max({0.0, g.y0 + iy * cell - c.y, c.y - (g.y0 + (iy + 1) * cell)});
+        if (dx * dx + dy * dy <= cd * cd) f(static_cast<size_t>(iy) * g.nx + ix);
+      }
+  };
+  for (const V3& c : s.centres) forCells(c, [&](size_t k) { ++count[k]; });
+  g.start.assign(ncell + 1, 0);
+  for (size_t k = 0; k < ncell; ++k) g.start[k + 1] = g.start[k] + count[k];
+  g.items.resize(g.start[ncell]);
+  std::vector<int> fill(g.start.begin(), g.start.end() - 1);
+  for (size_t i = 0; i < s.centres.size(); ++i)
+    forCells(s.centres[i], [&](size_t k) {
+      g.items[fill[k]++] = static_cast<int>(i);
+      g.max_z[k] = std::max(g.max_z[k], s.centres[i].z + cd);  // "max z plus collision distance"
+    });
+  return g;
+}
+
+}  // namespace place_planner

@@ -1,0 +1,248 @@
+#include "place_planner/stability.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "place_planner/quality.h"
+
+namespace place_planner {
+namespace {
+
+const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();  // -d_g in G
+
+// 2D analysis of a support polygon in the plane through `origin` with normal `n` (unit),
+// centre of mass projected along gravity (-z).
+struct Support {
+  bool valid = false;
+  std::vector<Eigen::Vector2d> hull2;
+  std::vector<Eigen::Vector3d> hull3;
+  Eigen::Vector2d c_hat_O, c_omega;
+  double inside = 0, h = 0, quality = -1, tip = 0;
+  Eigen::Vector3d u, w, origin, n;
+};
+
+Support analyse(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& origin,
+                const Eigen::Vector3d& n, const Eigen::Vector3d& com) {
+  Support s;
+  s.origin = origin;
+  s.n = n;
+  s.u = n.unitOrthogonal();
+  s.w = n.cross(s.u);
+  std::vector<Eigen::Vector2d> p2;
+  for (const auto& p : pts) p2.emplace_back((p - origin).dot(s.u), (p - origin).dot(s.w));
+  s.hull2 = convexHull2d(p2);
+  if (s.hull2.size() < 3 || std::abs(polygonArea(s.hull2)) < 1e-10) return s;
+  // c^_O: the centre of mass projected along gravity onto P.
+  const double den = -kUp.dot(n);
+  if (std::abs(den) < 1e-9) return s;
+  const double t = (origin - com).dot(n) / den;
+  const Eigen::Vector3d proj = com - t * kUp;
+  s.c_hat_O = Eigen::Vector2d((proj - origin).dot(s.u), (proj - origin).dot(s.w));
+  s.c_omega = polygonCentroid(s.hull2);
+  s.h = std::abs((com - origin).dot(n));
+  s.inside = signedBoundaryDistance(s.hull2, s.c_hat_O);
+  s.tip = std::atan2(s.inside, std::max(s.h, 1e-9));
+  s.quality = quality(s.hull2, s.c_hat_O, s.h);
+  for (const auto& q : s.hull2) s.hull3.push_back(origin + q.x() * s.u + q.y() * s.w);
+  s.valid = true;
+  return s;
+}
+
+// Failure direction in 3D from a support: away from the hull centre, or (centred but too close
+// to an edge) outward through the nearest edge.
+Eigen::Vector3d tipDirection(const Support& s) {
+  Eigen::Vector2d d = s.c_hat_O - s.c_omega;
+  if (d.norm() < 1e-6) {
+    double best = 1e300;
+    for (size_t i = 0; i < s.hull2.size(); ++i) {
+      const Eigen::Vector2d a = s.hull2[i], e = s.hull2[(i + 1) % s.hull2.size()] - a;
+      const Eigen::Vector2d outward(e.y(), -e.x());
+      const double dist = (a - s.c_hat_O).dot(outward.normalized());
+      if (dist < best) {
+        best = dist;
+        d = outward;
+      }
+    }
+  }
+  const Eigen::Vector3d d3 = d.x() * s.u + d.y() * s.w;
+  Eigen::Vector3d h = d3 - d3.dot(kUp) * kUp;  // rotations tip about horizontal axes
+  if (h.norm() < 1e-9) h = d3;
+  return h.normalized();
+}
+
+Eigen::Vector3d farthest(const std::vector<ContactPoint>& c, const Eigen::Vector3d& d) {
+  Eigen::Vector3d best = c.front().p_W;
+  for (const auto& p : c)
+    if (p.p_W.dot(d) > best.dot(d)) best = p.p_W;
+  return best;
+}
+
+}  // namespace
+
+double nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd* xout) {
+  const int n = static_cast<int>(A.cols());
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+  std::vector<bool> passive(n, false);
+  const double tol = 1e-10 * (1.0 + A.cwiseAbs().maxCoeff());
+  for (int outer = 0; outer < 3 * n + 10; ++outer) {
+    Eigen::VectorXd w = A.transpose() * (b - A * x);
+    int t = -1;
+    double wmax = tol;
+    for (int j = 0; j < n; ++j)
+      if (!passive[j] && w[j] > wmax) {
+        wmax = w[j];
+        t = j;
+      }
+    if (t < 0) break;
+    passive[t] = true;
+    for (int inner = 0; inner < 3 * n + 10; ++inner) {
+      std::vector<int> P;
+      for (int j = 0; j < n; ++j)
+        if (passive[j]) P.push_back(j);
+      Eigen::MatrixXd Ap(A.rows(), P.size());
+      for (size_t k = 0; k < P.size(); ++k) Ap.col(k) = A.col(P[k]);
+      const Eigen::VectorXd zp = Ap.colPivHouseholderQr().solve(b);
+      Eigen::VectorXd z = Eigen::VectorXd::Zero(n);
+      bool ok = true;
+      for (size_t k = 0; k < P.size(); ++k) {
+        z[P[k]] = zp[k];
+        if (zp[k] <= 0) ok = false;
+      }
+      if (ok) {
+        x = z;
+        break;
+      }
+      double alpha = 1.0;
+      for (int j : P)
+        if (z[j] <= 0) alpha = std::min(alpha, x[j] / (x[j] - z[j]));
+      x += alpha * (z - x);
+      for (int j : P)
+        if (x[j] <= tol) {
+          passive[j] = false;
+          x[j] = 0;
+        }
+    }
+  }
+  if (xout) *xout = x;
+  return (A * x - b).norm();
+}
+
+bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                 const Eigen::Vector3d& f_ext, double friction, double L) {
+  if (contacts.empty()) return false;
+  // Inscribed 4-edge pyramid: conservative against the true cone.
+  const double mu = friction / std::sqrt(2.0);
+  Eigen::MatrixXd A(6, 4 * contacts.size());
+  for (size_t i = 0; i < contacts.size(); ++i) {
+    const Eigen::Vector3d n = contacts[i].n_W.normalized();
+    const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+    const Eigen::Vector3d r = contacts[i].p_W - com;
+    const Eigen::Vector3d e[4] = {n + mu * (t1 + t2), n + mu * (t1 - t2), n - mu * (t1 + t2),
+                                  n - mu * (t1 - t2)};
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d f = e[k].normalized();
+      A.block<3, 1>(0, 4 * i + k) = f;
+      A.block<3, 1>(3, 4 * i + k) = r.cross(f) / L;  // torques in units of force
+    }
+  }
+  Eigen::VectorXd b(6);
+  b << -f_ext, Eigen::Vector3d::Zero();
+  return nnls(A, b) < 1e-6;
+}
+
+Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                            const StabilityParams& prm) {
+  Stability r;
+  if (contacts.empty()) return r;
+  const double cone = std::atan(prm.friction);
+  // ---------------------------------------------------------------- planar case
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : contacts) c += p.p_W;
+  c /= static_cast<double>(contacts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : contacts) cov += (p.p_W - c) * (p.p_W - c).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  Eigen::Vector3d n = es.eigenvectors().col(0).normalized();
+  if (n.dot(kUp) < 0) n = -n;
+  double off = 0;
+  for (const auto& p : contacts) off = std::max(off, std::abs((p.p_W - c).dot(n)));
+  std::vector<Eigen::Vector3d> pts;
+  for (const auto& p : contacts) pts.push_back(p.p_W);
+  if (off <= prm.tol && n.dot(kUp) > 1e-3) {
+    r.planar = true;
+    r.plane_normal = n;
+    const Support s = analyse(pts, c, n, com);
+    if (!s.valid) return r;  // collinear: the tree rotates further
+    r.hull = s.hull3;
+    r.quality = s.quality;
+    r.tipping_angle = s.tip;
+    r.com_inside = s.inside >= 0;
+    r.friction_ok = std::acos(std::clamp(n.dot(kUp), -1.0, 1.0)) < cone;  // angle(P, -d_g) < atan(mu)
+    r.stable = r.friction_ok && r.com_inside && s.tip >= prm.min_tipping_angle && s.quality >= 0.3;
+    if (r.stable) {
+      r.failure = Failure::kNone;
+    } else if (!r.friction_ok) {
+      r.failure = Failure::kSlide;
+      const Eigen::Vector3d down = -kUp - (-kUp).dot(n) * n;  // d_g projected onto P
+      r.d_f = down.normalized();
+    } else {
+      r.failure = Failure::kTip;
+      r.d_f = tipDirection(s);
+    }
+    r.pivot = farthest(contacts, r.d_f);
+    return r;
+  }
+  // ---------------------------------------------------------------- non-planar case
+  // Paper's heuristic, first step: contacts whose normal lies in the friction cone about -d_g
+  // support like a floor; their support polygon Omega' is tested as in the planar case.
+  std::vector<Eigen::Vector3d> below;
+  double zmin = 1e300;
+  for (const auto& p : contacts) {
+    zmin = std::min(zmin, p.p_W.z());
+    if (std::acos(std::clamp(p.n_W.dot(kUp), -1.0, 1.0)) < cone) below.push_back(p.p_W);
+  }
+  Support s1;
+  if (below.size() >= 3) {
+    Eigen::Vector3d cb = Eigen::Vector3d::Zero();
+    for (const auto& p : below) cb += p;
+    cb /= static_cast<double>(below.size());
+    s1 = analyse(below, cb, kUp, com);
+  }
+  // The projected support of all contacts ranks non-planar poses.
+  const Support all = analyse(pts, Eigen::Vector3d(c.x(), c.y(), zmin), kUp, com);
+  const Support& ref = s1.valid ? s1 : all;
+  if (ref.valid) {
+    r.hull = ref.hull3;
+    r.tipping_angle = ref.tip;
+    r.quality = ref.quality;
+    r.com_inside = ref.inside >= 0;
+  }
+  bool stable = s1.valid && s1.inside >= 0 && s1.tip >= prm.min_tipping_angle && s1.quality >= 0.3;
+  if (!stable) {
+    // Equilibrium: forces within the friction cones balance gravity, also with gravity tilted
+    // by half the friction angle in four directions (a margin against sliding and tipping).
+    const double L = std::max(1e-3, (com - c).norm());
+    const double tilt = 0.5 * cone;
+    stable = equilibrium(contacts, com, -kUp, prm.friction, L);
+    for (int k = 0; k < 4 && stable; ++k) {
+      const double phi = k * M_PI / 2;
+      const Eigen::Vector3d g(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi),
+                              -std::cos(tilt));
+      stable = equilibrium(contacts, com, g, prm.friction, L);
+    }
+  }
+  r.friction_ok = stable;
+  r.stable = stable;
+  if (stable) {
+    r.failure = Failure::kNone;
+    r.quality = std::max(r.quality, 0.3);  // Q is a ranking here; equilibrium decided stability
+  } else {
+    r.failure = Failure::kTip;
+    r.d_f = ref.valid ? tipDirection(ref) : Eigen::Vector3d::UnitX();
+  }
+  r.pivot = farthest(contacts, r.d_f);
+  return r;
+}
+
+}  // namespace place_planner

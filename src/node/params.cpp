@@ -107,6 +107,8 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("max_candidates", &p.max_candidates);
   r.read("threads", &p.threads);
   r.read("max_local_optimisation_steps", &p.max_local_optimisation_steps);
+  r.read("min_tipping_angle_deg", &p.min_tipping_angle_deg);
+  // start_orientation is not a parameter: each goal's object_pose gives it.
   r.read("min_quality", &p.min_quality);
   r.read("merge_distance", &p.merge_distance);
   r.read("merge_angle_deg", &p.merge_angle_deg);

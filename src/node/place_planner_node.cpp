@@ -69,10 +69,8 @@ const char* codeName(uint8_t code) {
 }  // namespace
 
 struct PlacePlannerNode::Prepared {
-  Mesh object;               // in frame O' = O rotated by R_WO (see prepare)
-  Mesh object_O;             // in O, for the markers
-  Mesh area_W;               // in the planning frame
-  Eigen::Isometry3d X_O1O;   // maps O -> O' (a rotation); the answer's X_WO = X_WO' * X_O1O
+  Mesh object_O;  // in the object's mesh frame O
+  Mesh area_W;    // in the planning frame
   PlannerConfig config;
   bool has_grasp = false;
   Eigen::Isometry3d X_OG = Eigen::Isometry3d::Identity();
@@ -148,10 +146,6 @@ PlacePlannerNode::Prepared PlacePlannerNode::prepare(const PlacePlanGoal& goal) 
                                      ? Eigen::Isometry3d::Identity()
                                      : Eigen::Isometry3d(X_WO.inverse() *
                                                          lookup(object->header.frame_id, "object mesh"));
-  // The planner gets the object rotated into the planning frame's orientation (frame O'), so
-  // orientation "keep" starts from the object's current orientation.
-  out.X_O1O = Eigen::Isometry3d::Identity();
-  out.X_O1O.linear() = X_WO.rotation();
 
   // Validated in the frame they came in (so an index or coordinate in a message names the element
   // as sent), then mapped.
@@ -160,7 +154,6 @@ PlacePlannerNode::Prepared PlacePlannerNode::prepare(const PlacePlanGoal& goal) 
   try {
     fromMsg(*object, "object mesh", &vertices, &polygons);
     out.object_O = mappedBy(buildMesh(vertices, polygons, "object mesh"), X_OM);
-    out.object = mappedBy(out.object_O, out.X_O1O);
     fromMsg(*area, "placement area mesh", &vertices, &polygons);
     out.area_W = mappedBy(buildMesh(vertices, polygons, "placement area mesh"), X_WA);
   } catch (const MeshError& e) {
@@ -170,6 +163,8 @@ PlacePlannerNode::Prepared PlacePlannerNode::prepare(const PlacePlanGoal& goal) 
   // Config: the parameters, overridden by the goal's non-zero fields.
   PlannerConfig& c = out.config;
   c = config_.planner;
+  // Orientation "keep" starts from the object's current orientation; the others turn it least.
+  c.start_orientation = Eigen::Quaterniond(X_WO.rotation());
   const auto direction = [&](const geometry_msgs::Vector3Stamped& v, const char* field,
                              Eigen::Vector3d* value) {
     const Eigen::Vector3d d = fromMsg(v.vector);
@@ -245,7 +240,7 @@ void PlacePlannerNode::execute(const PlacePlanGoalConstPtr& goal) {
   PlanResult plan;
   std::string failure;
   try {
-    plan = planner_.plan(prepared.object, prepared.area_W, prepared.config,
+    plan = planner_.plan(prepared.object_O, prepared.area_W, prepared.config,
                          [this](const Progress& p) { return onProgress(p); });
   } catch (const std::exception& e) {
     failure = e.what();
@@ -264,11 +259,6 @@ void PlacePlannerNode::execute(const PlacePlanGoalConstPtr& goal) {
     return;
   }
 
-  // Back from O' to the object's mesh frame O.
-  for (Candidate& c : plan.candidates) {
-    c.X_WO = c.X_WO * prepared.X_O1O;
-    for (auto& X : c.intermediate_poses) X = X * prepared.X_O1O;
-  }
   const ros::Time stamp = ros::Time::now();
   result.candidates.resize(plan.candidates.size());
   for (size_t i = 0; i < plan.candidates.size(); ++i) {

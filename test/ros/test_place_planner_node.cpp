@@ -32,6 +32,9 @@ using Result = PlacePlanResult;
 constexpr char kAction[] = "/place_planner/place_plan";
 // Test 2 and the issue: the same scene given in another frame gives the same answer to 1 mm.
 constexpr double kSameAnswer = 1e-3;
+// Q of the same pose from the same scene in another frame: float32 vertices and the sphere
+// model's sampling move it by up to 0.011 (measured).
+constexpr double kSameQuality = 0.03;
 // Poses copied or composed in double precision: only rounding separates them.
 constexpr double kExact = 1e-6;
 // A vertex resting on the area (the planner's contact tolerance is well below this).
@@ -177,7 +180,9 @@ TEST(PlacePlannerNode, MeshesFromTopicsGiveStablePoseInPlanningFrame) {
     EXPECT_NEAR(best.contact_points[i].z, 0.0, kOnSurface);
     EXPECT_LE(std::abs(best.contact_points[i].x), 0.2 + kOnSurface);
     EXPECT_LE(std::abs(best.contact_points[i].y), 0.15 + kOnSurface);
-    EXPECT_NEAR(best.contact_normals[i].z, 1.0, 1e-3);
+    // Unit, pointing at the object (up); the sphere model tilts normals at the box's edges.
+    EXPECT_NEAR(fromMsg(best.contact_normals[i]).norm(), 1.0, 1e-6);
+    EXPECT_GT(best.contact_normals[i].z, 0.5);
   }
   // The path ends at the goal pose and starts above it.
   const auto& path = best.intermediate_poses;
@@ -210,16 +215,21 @@ TEST(PlacePlannerNode, InlineMeshesInTransformedFrameGiveSameAnswer) {
   const auto& got = a.result.candidates;
   ASSERT_EQ(got.size(), ref.size());
   EXPECT_EQ(got.front().pose.header.frame_id, "world");
-  EXPECT_NEAR(got.front().quality, ref.front().quality, 1e-3);
+  EXPECT_NEAR(got.front().quality, ref.front().quality, kSameQuality);
   // Same set of candidates (ties in Q may order them differently): each has a twin within 1 mm.
   for (const auto* pair : {&ref, &got}) {
     const auto& from = *pair;
     const auto& to = pair == &ref ? got : ref;
     for (const auto& c : from) {
+      const PlacementCandidate* twin = nullptr;
       double best = std::numeric_limits<double>::infinity();
       for (const auto& d : to) {
-        if (angle(c.pose.pose, d.pose.pose) < 0.01) best = std::min(best, distance(c.pose.pose, d.pose.pose));
+        const double dist = distance(c.pose.pose, d.pose.pose);
+        if (angle(c.pose.pose, d.pose.pose) < 0.01 && dist < best) best = dist, twin = &d;
       }
+      ASSERT_NE(twin, nullptr);
+      EXPECT_NEAR(twin->quality, c.quality, kSameQuality);
+      EXPECT_EQ(twin->stable, c.stable);
       EXPECT_LT(best, kSameAnswer) << "candidate at (" << c.pose.pose.position.x << ", "
                                    << c.pose.pose.position.y << ", " << c.pose.pose.position.z
                                    << ") has no twin";

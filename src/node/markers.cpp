@@ -15,6 +15,7 @@ constexpr double kFloorSphere = 0.01;      // m, diameter of a floor point spher
 constexpr double kNormalLength = 0.04;     // m, contact normal arrows
 constexpr float kCandidateAlpha = 0.55f;   // translucent objects at the goal poses
 constexpr float kPathAlpha = 0.12f;        // faded intermediate poses
+constexpr size_t kMaxNormals = 24;         // arrows per candidate, evenly spread over its contacts
 
 Marker makeMarker(const MarkerOptions& o, const char* ns, int id, int type) {
   Marker m;
@@ -100,21 +101,6 @@ visualization_msgs::MarkerArray buildMarkers(const Mesh& object_O, const Mesh& a
     addTriangles(object_O, &object);
     array.markers.push_back(object);
 
-    for (const auto& contact : c.contacts) {
-      geometry_msgs::Point p;
-      toMsg(contact.p_W, &p);
-      contacts.points.push_back(p);
-      Marker arrow = makeMarker(o, marker_ns::kContactNormals, normal_id++, Marker::ARROW);
-      arrow.scale.x = 0.003;  // shaft diameter
-      arrow.scale.y = 0.006;  // head diameter
-      arrow.scale.z = 0.01;   // head length
-      setColour(&arrow, 0.1f, 0.3f, 1.0f, 1.0f);
-      geometry_msgs::Point tip;
-      toMsg(Eigen::Vector3d(contact.p_W + kNormalLength * contact.n_W), &tip);
-      arrow.points = {p, tip};
-      array.markers.push_back(arrow);
-    }
-
     if (i < o.text_count) {
       Marker text = makeMarker(o, marker_ns::kQuality, i, Marker::TEXT_VIEW_FACING);
       const Eigen::Vector3d above =
@@ -127,6 +113,26 @@ visualization_msgs::MarkerArray buildMarkers(const Mesh& object_O, const Mesh& a
       std::snprintf(buf, sizeof buf, "#%d Q=%.2f%s", i + 1, c.quality, c.stable ? "" : " (unstable)");
       text.text = buf;
       array.markers.push_back(text);
+    }
+
+    // Contacts of the best few only: the sphere model gives hundreds per pose.
+    if (i >= std::max(1, o.text_count)) continue;
+    const size_t stride = std::max<size_t>(1, (c.contacts.size() + kMaxNormals - 1) / kMaxNormals);
+    for (size_t k = 0; k < c.contacts.size(); ++k) {
+      const ContactPoint& contact = c.contacts[k];
+      geometry_msgs::Point p;
+      toMsg(contact.p_W, &p);
+      contacts.points.push_back(p);
+      if (k % stride != 0) continue;
+      Marker arrow = makeMarker(o, marker_ns::kContactNormals, normal_id++, Marker::ARROW);
+      arrow.scale.x = 0.003;  // shaft diameter
+      arrow.scale.y = 0.006;  // head diameter
+      arrow.scale.z = 0.01;   // head length
+      setColour(&arrow, 0.1f, 0.3f, 1.0f, 1.0f);
+      geometry_msgs::Point tip;
+      toMsg(Eigen::Vector3d(contact.p_W + kNormalLength * contact.n_W), &tip);
+      arrow.points = {p, tip};
+      array.markers.push_back(arrow);
     }
   }
   if (!contacts.points.empty()) array.markers.push_back(contacts);

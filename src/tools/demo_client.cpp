@@ -9,6 +9,7 @@
 #include <ros/ros.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -102,7 +103,12 @@ int run(ros::NodeHandle& pnh) {
   for (size_t i = 0; i < result->candidates.size() && static_cast<int>(i) < rows; ++i) {
     const auto& c = result->candidates[i];
     const Eigen::Isometry3d X = place_planner::fromMsg(c.pose.pose);
-    const Eigen::Vector3d ypr = X.rotation().eulerAngles(2, 1, 0) * 180.0 / M_PI;
+    // Fixed-axis roll, pitch, yaw (as tf2's getRPY), in (-180, 180].
+    const Eigen::Matrix3d R = X.rotation();
+    const double deg = 180.0 / M_PI;
+    const Eigen::Vector3d ypr(std::atan2(R(1, 0), R(0, 0)) * deg,
+                              std::asin(std::clamp(-R(2, 0), -1.0, 1.0)) * deg,
+                              std::atan2(R(2, 1), R(2, 2)) * deg);
     const Eigen::Vector3d p = X.translation();
     report("#%-3zu  %.3f  %-6s  (%7.3f, %7.3f, %7.3f)   (%6.1f, %6.1f, %6.1f)   %zu\n", i + 1,
                 c.quality, c.stable ? "yes" : "no", p.x(), p.y(), p.z(), ypr[2], ypr[1], ypr[0],

@@ -14,8 +14,8 @@ namespace place_planner {
 namespace marker_ns {
 constexpr const char* kPlacementArea = "placement_area";   // grey triangle list
 constexpr const char* kCandidates = "candidates";          // object at each goal pose, red->green by Q
-constexpr const char* kContacts = "contacts";              // red spheres at the contact points
-constexpr const char* kContactNormals = "contact_normals"; // arrows along the contact normals
+constexpr const char* kContacts = "contacts";              // red spheres at the contact points (best few)
+constexpr const char* kContactNormals = "contact_normals"; // arrows along the normals (<= 24 per candidate)
 constexpr const char* kFloorPoints = "floor_points";       // orange spheres
 constexpr const char* kBestPath = "best_path";             // best candidate's intermediate poses, faded
 constexpr const char* kQuality = "quality";                // "#1 Q=0.87" text above the best few
@@ -25,7 +25,7 @@ struct MarkerOptions {
   std::string frame_id = "world";  // the planning frame W
   ros::Time stamp;
   int max_candidates = 10;         // object outlines drawn, best first
-  int text_count = 3;              // quality labels, best first
+  int text_count = 3;              // quality labels and contacts, best first (contacts: >= 1)
 };
 
 // object_O: the object mesh in the frame whose poses the candidates' X_WO give. area_W: the

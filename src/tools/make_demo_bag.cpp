@@ -3,10 +3,13 @@
 //                 [--area-frame FRAME] [--object-frame FRAME]
 // NAME is a built-in scene (place_planner::scenes::byName: table, dish_rack, open_box,
 // binder_stack; mug, plate, pen, cube); anything with a '.' is read as a PLY/OBJ/STL file.
-// Topics: placement_area_mesh (default frame "world") and object_mesh (default frame "": the
-// vertices are in the object's own mesh frame). Both are written as latched connections, so
-// `rosbag play --keep-alive` serves them to nodes that start later.
+// Topics: placement_area_mesh (default frame "placement_area") and object_mesh (default frame
+// "": the vertices are in the object's own mesh frame), and /tf_static with the identity
+// world -> area frame (so the node's tf2 lookup and rviz's fixed frame "world" both work).
+// All are written as latched connections, so `rosbag play --keep-alive` serves them to nodes
+// that start later.
 #include <rosbag/bag.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <cstdio>
 #include <cstring>
@@ -35,7 +38,7 @@ int usage() {
 int main(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') return usage();
   const std::string out = argv[1];
-  std::string area = "binder_stack", object = "mug", area_frame = "world", object_frame;
+  std::string area = "binder_stack", object = "mug", area_frame = "placement_area", object_frame;
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
     if (i + 1 >= argc) return usage();
@@ -56,6 +59,21 @@ int main(int argc, char** argv) {
     (*header)["md5sum"] = ros::message_traits::md5sum<pcl_msgs::PolygonMesh>();
     (*header)["message_definition"] = ros::message_traits::definition<pcl_msgs::PolygonMesh>();
     rosbag::Bag bag(out, rosbag::bagmode::Write);
+    if (!area_frame.empty() && area_frame != "world") {
+      geometry_msgs::TransformStamped T;
+      T.header.stamp = stamp;
+      T.header.frame_id = "world";
+      T.child_frame_id = area_frame;
+      T.transform.rotation.w = 1.0;
+      tf2_msgs::TFMessage tf;
+      tf.transforms.push_back(T);
+      auto tf_header = boost::make_shared<ros::M_string>(*header);
+      (*tf_header)["type"] = ros::message_traits::datatype<tf2_msgs::TFMessage>();
+      (*tf_header)["md5sum"] = ros::message_traits::md5sum<tf2_msgs::TFMessage>();
+      (*tf_header)["message_definition"] = ros::message_traits::definition<tf2_msgs::TFMessage>();
+      bag.write("/tf_static", stamp, tf, tf_header);
+      std::printf("/tf_static: world -> %s (identity)\n", area_frame.c_str());
+    }
     for (const auto& [topic, name, frame] :
          {std::make_tuple("placement_area_mesh", area, area_frame),
           std::make_tuple("object_mesh", object, object_frame)}) {

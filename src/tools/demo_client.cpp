@@ -111,7 +111,8 @@ int run(ros::NodeHandle& pnh) {
                               std::atan2(R(2, 1), R(2, 2)) * deg);
     const Eigen::Vector3d p = X.translation();
     report("#%-3zu  %.3f  %-6s  (%7.3f, %7.3f, %7.3f)   (%6.1f, %6.1f, %6.1f)   %zu\n", i + 1,
-                c.quality, c.stable ? "yes" : "no", p.x(), p.y(), p.z(), ypr[2], ypr[1], ypr[0],
+                c.quality, c.stable ? "yes" : "no", p.x(), p.y(), p.z(), ypr[2] + 0.0,
+                ypr[1] + 0.0, ypr[0] + 0.0,  // + 0.0: no "-0.0"
                 c.contact_points.size());
   }
   std::fflush(stdout);

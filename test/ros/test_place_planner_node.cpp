@@ -450,6 +450,38 @@ TEST(PlacePlannerNode, GripperPoseIsPoseComposedWithGrasp) {
   }
 }
 
+// ---------------------------------------------------------------- goal fields
+TEST(PlacePlannerNode, BadGoalFieldIsInvalidGoalNamingIt) {
+  PlacePlanGoal goal = quickGoal();
+  goal.object_mesh = meshMsg(testObject(), "");
+  goal.placement_area_mesh = meshMsg(testArea(), "world");
+  goal.friction = -1.0;
+  Answer a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::INVALID_GOAL);
+  EXPECT_NE(a.result.error_message.find("friction"), std::string::npos) << a.result.error_message;
+  goal.friction = 0.0;
+  goal.orientation_mode = "upside_down";
+  a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::INVALID_GOAL);
+  EXPECT_NE(a.result.error_message.find("upside_down"), std::string::npos) << a.result.error_message;
+}
+
+TEST(PlacePlannerNode, TimeBudgetEndsLongPlanWithTimedOut) {
+  PlacePlanGoal goal = longGoal();
+  goal.time_budget = 0.3;  // s; the long plan needs several
+  const ros::WallTime t0 = ros::WallTime::now();
+  const Answer a = send(goal);
+  const double wall = (ros::WallTime::now() - t0).toSec();
+  EXPECT_EQ(a.result.error_code, Result::TIMED_OUT) << a.result.error_message;
+  EXPECT_EQ(a.state, actionlib::SimpleClientGoalState::ABORTED);
+  EXPECT_GE(a.result.planning_time, 0.3);
+  EXPECT_LT(a.result.planning_time, 0.3 + kCancelLatency);
+  EXPECT_LT(wall, 1.0);
+  std::printf("[budget] TIMED_OUT after %.3f s with %zu candidates\n", a.result.planning_time,
+              a.result.candidates.size());
+  for (const auto& c : a.result.candidates) EXPECT_EQ(c.pose.header.frame_id, "world");
+}
+
 // ---------------------------------------------------------------- parameters
 TEST(PlacePlannerParams, OutOfRangeAndWrongTypeAreNamed) {
   ros::NodeHandle nh("/params_test");

@@ -43,6 +43,8 @@ constexpr double kOnSurface = 2e-3;
 constexpr double kCancelLatency = 0.2;
 // Feedback is promised every 100 ms; allow scheduling jitter on a loaded 2-core CI machine.
 constexpr double kFeedbackGap = 0.15;
+// sizeof(PlannerConfig) when the YAML was last brought in line with it (x86-64, g++ 12).
+constexpr size_t kPlannerConfigSize = 256;
 
 // The scene of the quick goals: a box on a 0.4 x 0.3 m plane at z = 0.
 Mesh testArea() { return scenes::plane(0.4, 0.3); }
@@ -508,6 +510,48 @@ TEST(PlacePlannerParams, OutOfRangeAndWrongTypeAreNamed) {
   EXPECT_EQ(c.planner.orientation, OrientationMode::kKeep);
   EXPECT_EQ(c.planner.max_candidates, PlannerConfig().max_candidates);  // default kept
   nh.deleteParam("");
+}
+
+// config/place_planner.yaml (loaded into /place_planner by the .test file) lists every
+// PlannerConfig field with the struct's default: a field added or a default changed in
+// config.h without the YAML fails here.
+TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
+  ros::NodeHandle nh("/place_planner");
+  for (const char* name :
+       {"gravity", "approach", "friction", "floor_point_spacing", "min_floor_points", "lowest_n",
+        "max_rotations", "sphere_radius", "grid_cell_size", "orientation", "time_budget_ms",
+        "max_candidates", "threads", "max_local_optimisation_steps", "min_tipping_angle_deg",
+        "min_quality", "merge_distance", "merge_angle_deg", "backend", "region_min", "region_max",
+        "planning_frame", "tf_timeout", "feedback_period", "marker_candidates",
+        "marker_text_count"}) {
+    EXPECT_TRUE(nh.hasParam(name)) << name << " missing from config/place_planner.yaml";
+  }
+  const PlannerConfig d;
+  const PlannerConfig y = loadNodeConfig(nh).planner;
+  EXPECT_EQ(y.gravity, d.gravity);
+  EXPECT_EQ(y.approach, d.approach);
+  EXPECT_EQ(y.friction, d.friction);
+  EXPECT_EQ(y.floor_point_spacing, d.floor_point_spacing);
+  EXPECT_EQ(y.min_floor_points, d.min_floor_points);
+  EXPECT_EQ(y.lowest_n, d.lowest_n);
+  EXPECT_EQ(y.max_rotations, d.max_rotations);
+  EXPECT_EQ(y.sphere_radius, d.sphere_radius);
+  EXPECT_EQ(y.grid_cell_size, d.grid_cell_size);
+  EXPECT_EQ(y.orientation, d.orientation);
+  EXPECT_EQ(y.time_budget_ms, d.time_budget_ms);
+  EXPECT_EQ(y.max_candidates, d.max_candidates);
+  EXPECT_EQ(y.threads, d.threads);
+  EXPECT_EQ(y.max_local_optimisation_steps, d.max_local_optimisation_steps);
+  EXPECT_EQ(y.min_tipping_angle_deg, d.min_tipping_angle_deg);
+  EXPECT_EQ(y.min_quality, d.min_quality);
+  EXPECT_EQ(y.merge_distance, d.merge_distance);
+  EXPECT_EQ(y.merge_angle_deg, d.merge_angle_deg);
+  EXPECT_EQ(y.backend, d.backend);
+  EXPECT_EQ(y.region_min, d.region_min);
+  EXPECT_EQ(y.region_max, d.region_max);
+  // The struct's size: a new field changes it; then list it above and in the YAML.
+  EXPECT_EQ(sizeof(PlannerConfig), kPlannerConfigSize)
+      << "PlannerConfig changed: mirror the new field in config/place_planner.yaml and params.cpp";
 }
 
 TEST(PlacePlannerParams, NodeRefusesToStartWithBadParameter) {

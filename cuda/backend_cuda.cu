@@ -71,7 +71,8 @@ __global__ void vertexSurfaceKernel(ObjectView o, AreaView a, const RotationQuer
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= 2 * n) return;
   const int i = k / 2, sigma = k % 2 ? -1 : 1;
-  out[k] = vertexSurfaceAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp);
+  out[k] = vertexSurfaceAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp,
+                              sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
 }
 
 __global__ void edgeEdgeKernel(ObjectView o, AreaView a, const RotationQuery* q, double* out, int n,
@@ -79,7 +80,8 @@ __global__ void edgeEdgeKernel(ObjectView o, AreaView a, const RotationQuery* q,
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= 2 * n) return;
   const int i = k / 2, sigma = k % 2 ? -1 : 1;
-  out[k] = edgeEdgeAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp);
+  out[k] = edgeEdgeAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp,
+                         sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
 }
 
 __global__ void contactKernel(ObjectView o, AreaView a, const Rigid* X, SphereContact* c, int poses) {
@@ -96,7 +98,7 @@ class CudaBackend : public Backend {
   CudaBackend(const ObjectModel& o, const AreaModel& a, const TiltParams& tp) : tp_(tp) {
     obj_ = ObjectView{om_.upload(o), o.com, o.bounding_radius};
     const HeightGrid& g = a.grid;
-    area_ = AreaView{am_.upload(a), GridView{g.x0, g.y0, g.cell, g.nx, g.ny, g.collision_distance,
+    area_ = AreaView{am_.upload(a), GridView{g.x0, g.y0, g.cell, g.nx, g.ny, g.collision_distance, g.contact_gap,
                                              start_.upload(g.start), items_.upload(g.items),
                                              maxz_.upload(g.max_z)}};
     // Deep per-thread traversal stacks: raise the stack size for the rotation kernels.

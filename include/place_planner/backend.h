@@ -21,6 +21,9 @@ struct TranslationQuery {
 struct RotationQuery {
   Rigid X_GO;
   V3 s_A, d_A;  // axis point and unit direction, frame G
+  // Angles at or beyond these are not needed (a contact was already found there by the other
+  // rotation kernel): the search stops early.
+  double limit_ccw = kInf, limit_cw = kInf;
 };
 
 struct AnglePair {

@@ -25,6 +25,7 @@ struct HeightGrid {
   double x0 = 0, y0 = 0, cell = 1;
   int nx = 0, ny = 0;
   double collision_distance = 0;
+  double contact_gap = 0;    // see sphereContact
   std::vector<int> start;    // nx * ny + 1 offsets into items
   std::vector<int> items;    // area sphere indices
   std::vector<double> max_z; // per cell; -inf when empty
@@ -33,7 +34,7 @@ struct HeightGrid {
 struct MeshModel {
   std::vector<V3> vertices;
   std::vector<std::array<int, 3>> triangles;
-  std::vector<std::array<int, 2>> edges;
+  std::vector<std::array<int, 2>> edges;  // feature edges only (see featureEdges)
   std::vector<V3> triangle_normals;
   Bvh triangle_bvh, edge_bvh, vertex_bvh;
   SphereModel spheres;
@@ -50,6 +51,12 @@ struct AreaModel : MeshModel {  // frame G
   HeightGrid grid;
   Eigen::Matrix3d R_GW;  // rotation from the planning frame W into G
 };
+
+// Edges for the edge/edge tests: all but those between two (nearly) coplanar triangles. A
+// segment first touches a plane at an end point (or all along, when parallel), so contacts on
+// a flat region are found by the vertex/face tests; only creases, silhouettes and hole
+// borders can meet as edge against edge. flat_deg bounds the dihedral angle called flat.
+std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg = 2.0);
 
 MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius);
 ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius);

@@ -44,7 +44,8 @@ class CpuBackend : public Backend {
     parallelFor(2 * q.size(), threads_, [&](size_t k) {
       const size_t i = k / 2;
       const int sigma = k % 2 ? -1 : 1;
-      const double th = vertexSurfaceAngle(obj_, area_, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp_);
+      const double th = vertexSurfaceAngle(obj_, area_, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp_,
+                                           sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
       (sigma > 0 ? a[i].ccw : a[i].cw) = th;
     });
   }
@@ -53,7 +54,8 @@ class CpuBackend : public Backend {
     parallelFor(2 * q.size(), threads_, [&](size_t k) {
       const size_t i = k / 2;
       const int sigma = k % 2 ? -1 : 1;
-      const double th = edgeEdgeAngle(obj_, area_, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp_);
+      const double th = edgeEdgeAngle(obj_, area_, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp_,
+                                           sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
       (sigma > 0 ? a[i].ccw : a[i].cw) = th;
     });
   }
@@ -86,7 +88,7 @@ ObjectView view(const ObjectModel& o) {
 
 AreaView view(const AreaModel& a) {
   const HeightGrid& g = a.grid;
-  return AreaView{meshView(a), GridView{g.x0, g.y0, g.cell, g.nx, g.ny, g.collision_distance,
+  return AreaView{meshView(a), GridView{g.x0, g.y0, g.cell, g.nx, g.ny, g.collision_distance, g.contact_gap,
                                         g.start.data(), g.items.data(), g.max_z.data()}};
 }
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <mutex>
 
 #include "place_planner/backend.h"
@@ -84,6 +85,40 @@ double angleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 
 std::once_flag g_backend_log;
 
+// FNV-1a over the bytes of the area mesh and the model parameters.
+uint64_t fingerprint(const Mesh& area, const Eigen::Vector3d& g, double r, double cd, double cell) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* p, size_t n) {
+    const unsigned char* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  };
+  for (const auto& v : area.vertices) mix(v.data(), 3 * sizeof(double));
+  for (const auto& t : area.triangles) mix(t.data(), 3 * sizeof(int));
+  const double p[6] = {g.x(), g.y(), g.z(), r, cd, cell};
+  mix(p, sizeof p);
+  return h;
+}
+
+// The area model (sphere model, BVHs, height grid) is the costly part of a plan and depends
+// only on the area and the radii: the last few are kept, as a node re-plans on the same area.
+std::shared_ptr<const AreaModel> cachedAreaModel(const Mesh& area, const Eigen::Vector3d& g,
+                                                 double r, double cd, double cell) {
+  static std::mutex mutex;
+  static std::vector<std::pair<uint64_t, std::shared_ptr<const AreaModel>>> cache;
+  const uint64_t key = fingerprint(area, g, r, cd, cell);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& e : cache)
+      if (e.first == key) return e.second;
+  }
+  auto model = std::make_shared<const AreaModel>(buildAreaModel(area, g, r, cd, cell));
+  std::lock_guard<std::mutex> lock(mutex);
+  cache.emplace_back(key, model);
+  if (cache.size() > 4) cache.erase(cache.begin());
+  return model;
+}
+
+
 }  // namespace
 
 PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConfig& config,
@@ -103,12 +138,15 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // Sphere radius: about 1% of the object's size, within 0.75 .. 4 mm (Section V-B).
   const double r = config.sphere_radius > 0 ? config.sphere_radius
                                             : std::clamp(0.01 * 2.0 * R_obj, 0.00075, 0.004);
-  const double cd = 2.0 * r;  // collision distance: sum of both radii
+  // The area's spheres may be coarser: its model is built once per area and cached.
+  const double r_area = 1.5 * r;
+  const double cd = r + r_area;  // collision distance: the sum of the radii (V-B)
   const double cell = config.grid_cell_size > 0 ? config.grid_cell_size : cd;
   st.sphere_radius = r;
   auto tp = Clock::now();
   const ObjectModel om = buildObjectModel(object, r);
-  const AreaModel am = buildAreaModel(area, d_g_W, r, cd, cell);
+  const std::shared_ptr<const AreaModel> area_model = cachedAreaModel(area, d_g_W, r_area, cd, cell);
+  const AreaModel& am = *area_model;
   const Eigen::Matrix3d R_GW = am.R_GW;
   st.steps.setup = msSince(tp);
   const V3 d_vis = toV3(R_GW * d_vis_W);
@@ -151,6 +189,17 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
         kept.push_back(p);
     }
     fp.points = kept;
+  }
+  // Anytime order: central floor points first (they rarely hang over an edge), so good poses
+  // come early; the set tried is the paper's, only the order changes.
+  if (!fp.points.empty()) {
+    V3 c = v3(0, 0, 0);
+    for (const V3& p : fp.points) c = c + p;
+    c = (1.0 / fp.points.size()) * c;
+    std::stable_sort(fp.points.begin(), fp.points.end(), [&](const V3& a, const V3& b) {
+      const V3 da = a - c, db = b - c;
+      return da.x * da.x + da.y * da.y < db.x * db.x + db.y * db.y;
+    });
   }
   for (const V3& p : fp.points) result.floor_points_W.push_back(R_GW.transpose() * toEigen(p));
   st.steps.floor_points = msSince(tp);
@@ -195,11 +244,12 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   };
 
   // Roots are processed in groups so good poses appear early (anytime behaviour).
+  // The first group is small so the first stable pose comes quickly.
   const int group = std::max(8, 4 * resolveThreads(config.threads));
   bool stop = !report();
-  for (int g0 = 0; g0 < num_roots && !stop; g0 += group) {
+  for (int g0 = 0, gsize = std::max(2, group / 4); g0 < num_roots && !stop; g0 += gsize, gsize = group) {
     std::vector<Node> translate, contact, rotating;
-    for (int k = g0; k < std::min(num_roots, g0 + group); ++k) {
+    for (int k = g0; k < std::min(num_roots, g0 + gsize); ++k) {
       const int f = k / static_cast<int>(orientations.size());
       const Eigen::Matrix3d& R = orientations[k % orientations.size()];
       const V3 p_f = fp.points[f];
@@ -262,6 +312,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
               best_q = std::max(best_q, s.quality);
             }
           };
+          if (getenv("PP_DEBUG")) std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d friction %d inside %d tip %.1f deg Q %.3f failure %d com (%.3f %.3f %.3f) zmin %.4f\n", n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable, s.friction_ok, s.com_inside, s.tipping_angle*180/M_PI, s.quality, (int)s.failure, com.x(), com.y(), com.z(), n.contacts.empty()?0.0:n.contacts[0].p_W.z());
           if (n.contacts.empty()) continue;
           if (s.stable) {
             leaf(true);
@@ -287,6 +338,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
               ++n.opt;
               n.s_A = step.s_A;
               n.d_A = step.d_A;
+              if (getenv("PP_DEBUG")) std::fprintf(stderr, "  local rotate d_f (%.3f %.3f %.3f) pivot (%.3f %.3f %.3f) axis (%.3f %.3f %.3f) n_P (%.3f %.3f %.3f)\n", s.d_f.x(), s.d_f.y(), s.d_f.z(), s.pivot.x(), s.pivot.y(), s.pivot.z(), step.d_A.x(), step.d_A.y(), step.d_A.z(), s.plane_normal.x(), s.plane_normal.y(), s.plane_normal.z());
               n.both_directions = false;
               n.local_rotation = true;
               rotating.push_back(std::move(n));
@@ -303,11 +355,22 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
       // -------------------------------------------------------------- rotation kernels (V-C)
       if (!rotating.empty()) {
         std::vector<RotationQuery> q;
-        for (const Node& n : rotating) q.push_back({n.X, toV3(n.s_A), toV3(n.d_A)});
+        for (const Node& n : rotating) {
+          RotationQuery rq{n.X, toV3(n.s_A), toV3(n.d_A)};
+          // Directions a contact blocks, or not asked for, are not searched (limit 0).
+          if (blocked(n.contacts, n.s_A, n.d_A, 1, 0.5 * cd)) rq.limit_ccw = 0;
+          if (!n.both_directions || blocked(n.contacts, n.s_A, n.d_A, -1, 0.5 * cd)) rq.limit_cw = 0;
+          q.push_back(rq);
+        }
         std::vector<AnglePair> av, ae;
         tp = Clock::now();
         backend->vertexSurfaceRotation(q, av);
         st.steps.tilt_vertex += msSince(tp);
+        // Edge/edge only has to beat the vertex/surface angle.
+        for (size_t i = 0; i < q.size(); ++i) {
+          q[i].limit_ccw = std::min(q[i].limit_ccw, av[i].ccw);
+          q[i].limit_cw = std::min(q[i].limit_cw, av[i].cw);
+        }
         tp = Clock::now();
         backend->edgeEdgeRotation(q, ae);
         st.steps.tilt_edge += msSince(tp);
@@ -316,8 +379,8 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
           for (int sigma : {1, -1}) {
             if (sigma < 0 && !n.both_directions) continue;
             const double a = sigma > 0 ? std::min(av[i].ccw, ae[i].ccw) : std::min(av[i].cw, ae[i].cw);
-            if (a >= kInf) continue;  // turns freely: no resting pose that way
-            if (blocked(n.contacts, n.s_A, n.d_A, sigma, 0.5 * cd)) continue;
+            if (getenv("PP_DEBUG")) std::fprintf(stderr, "root %d depth %d opt %d local %d sigma %d contacts %zu angle %.2f deg (v %.2f e %.2f)\n", n.root, n.depth, n.opt, (int)n.local_rotation, sigma, n.contacts.size(), a*180/M_PI, (sigma>0?av[i].ccw:av[i].cw)*180/M_PI, (sigma>0?ae[i].ccw:ae[i].cw)*180/M_PI);
+            if (a >= kInf) continue;  // blocked, or turns freely: no resting pose that way
             Node c;
             c.X = rotated(n.X, n.s_A, n.d_A, sigma * a);
             c.root = n.root;
@@ -335,7 +398,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
         break;
       }
     }
-    st.floor_points_done = std::min(num_roots, g0 + group) / static_cast<int>(orientations.size());
+    st.floor_points_done = std::min(num_roots, g0 + gsize) / static_cast<int>(orientations.size());
     if (!stop && !report()) stop = true;
   }
 

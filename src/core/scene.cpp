@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <map>
 
 namespace place_planner {
 
@@ -25,6 +27,32 @@ Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W) {
   return Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
+std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg) {
+  std::map<std::pair<int, int>, std::vector<int>> adjacent;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      int a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      if (a > b) std::swap(a, b);
+      adjacent[{a, b}].push_back(static_cast<int>(t));
+    }
+  const double cos_flat = std::cos(flat_deg * M_PI / 180.0);
+  auto normal = [&](int t) {
+    const auto& tri = mesh.triangles[t];
+    return (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
+        .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]])
+        .normalized();
+  };
+  std::vector<std::array<int, 2>> out;
+  for (const auto& e : mesh.edges) {
+    const auto it = adjacent.find({e[0], e[1]});
+    if (it != adjacent.end() && it->second.size() == 2 &&
+        std::abs(normal(it->second[0]).dot(normal(it->second[1]))) >= cos_flat)
+      continue;  // flat: the first contact there is a vertex's (see scene.h)
+    out.push_back(e);
+  }
+  return out;
+}
+
 MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius) {
   MeshModel m;
   m.vertices.reserve(mesh.vertices.size());
@@ -34,7 +62,7 @@ MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphe
     aabbAdd(m.bounds, m.vertices.back());
   }
   m.triangles = mesh.triangles;
-  m.edges = mesh.edges;
+  m.edges = featureEdges(mesh);
   std::vector<Aabb> tri_boxes, edge_boxes, vert_boxes;
   tri_boxes.reserve(m.triangles.size());
   for (const auto& t : m.triangles) {
@@ -54,7 +82,7 @@ MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphe
   m.triangle_bvh = buildBvh(tri_boxes);
   m.edge_bvh = buildBvh(edge_boxes);
   m.vertex_bvh = buildBvh(vert_boxes);
-  m.spheres = sampleSpheres(m.vertices, m.triangles, m.edges, sphere_radius);
+  m.spheres = sampleSpheres(m.vertices, m.triangles, mesh.edges, sphere_radius);
   std::vector<Aabb> sphere_boxes;
   sphere_boxes.reserve(m.spheres.centres.size());
   for (const V3& c : m.spheres.centres) sphere_boxes.push_back(Aabb{c, c});

@@ -70,6 +70,7 @@ SphereModel sampleSpheres(const std::vector<V3>& vertices,
 HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, double cell) {
   HeightGrid g;
   g.collision_distance = cd;
+  g.contact_gap = 0.2 * cd;
   g.cell = cell;
   g.x0 = bounds.lo.x - cd;
   g.y0 = bounds.lo.y - cd;

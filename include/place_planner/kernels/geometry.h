@@ -174,16 +174,24 @@ PP_HD Revolution revolutionOf(V3 p0, V3 p1) {
 // revolution of the rotating segment (step 3), intersects the fixed segment with it and
 // measures the angle from the rotating segment's point at that height to the hit (step 4).
 // Writes up to 4 angles in [0, 2 pi); returns count.
-PP_HD int edgeEdgeAngles(V3 p0, V3 p1, V3 q0, V3 q1, V3 s_A, V3 d_A, double out[4]) {
-  // Orthonormal frame with z = d_A, origin s_A.
+PP_HD int edgeEdgeAnglesAxis(V3 P0, V3 P1, V3 Q0, V3 Q1, double out[4]);
+// Axis frame of (s_A, d_A): origin s_A, z = d_A (step 2 of V-C.2b).
+struct AxisFrame {
+  V3 o, ex, ey, ez;
+};
+PP_HD AxisFrame axisFrame(V3 s_A, V3 d_A) {
   const V3 ref = fabs(d_A.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
   const V3 ex = normalized(cross(ref, d_A));
-  const V3 ey = cross(d_A, ex);
-  auto toAxis = [&](V3 p) {
-    const V3 r = p - s_A;
-    return v3(dot(r, ex), dot(r, ey), dot(r, d_A));
-  };
-  const V3 P0 = toAxis(p0), P1 = toAxis(p1), Q0 = toAxis(q0), Q1 = toAxis(q1);
+  return AxisFrame{s_A, ex, cross(d_A, ex), d_A};
+}
+PP_HD V3 toAxis(const AxisFrame& f, V3 p) {
+  const V3 r = p - f.o;
+  return v3(dot(r, f.ex), dot(r, f.ey), dot(r, f.ez));
+}
+
+// Edge/edge rotational contact in the axis frame (rotation about +z through the origin):
+// P0P1 rotates, Q0Q1 is fixed. See edgeEdgeAngles.
+PP_HD int edgeEdgeAnglesAxis(V3 P0, V3 P1, V3 Q0, V3 Q1, double out[4]) {
   // (1) Pretest: the z ranges must overlap, and the radius ranges too.
   const double pz0 = minv(P0.z, P1.z), pz1 = maxv(P0.z, P1.z);
   const double qz0 = minv(Q0.z, Q1.z), qz1 = maxv(Q0.z, Q1.z);
@@ -258,9 +266,38 @@ PP_HD int edgeEdgeAngles(V3 p0, V3 p1, V3 q0, V3 q1, V3 s_A, V3 d_A, double out[
   return k;
 }
 
+PP_HD int edgeEdgeAngles(V3 p0, V3 p1, V3 q0, V3 q1, V3 s_A, V3 d_A, double out[4]) {
+  const AxisFrame f = axisFrame(s_A, d_A);
+  return edgeEdgeAnglesAxis(toAxis(f, p0), toAxis(f, p1), toAxis(f, q0), toAxis(f, q1), out);
+}
+
 // Conservative bounding box of the arc swept by p rotating about (s_A, d_A) through angles
 // [a0, a1] (a1 - a0 <= pi/2 keeps it tight): the chord end points and the arc midpoint pushed
 // out to the tangent intersection.
+// Rotation about (s, d) by the angle whose cosine and sine are c, sn.
+PP_HD V3 rotateAboutCS(V3 p, V3 s, V3 d, double c, double sn) {
+  const V3 r = p - s;
+  return s + c * r + sn * cross(d, r) + (1.0 - c) * dot(d, r) * d;
+}
+
+// An angle window [a0, a1] with its sines and cosines, for arcBoxW.
+struct AngleWindow {
+  double c0, s0, c1, s1, cm, sm, inv_cos_half;
+};
+PP_HD AngleWindow angleWindow(double a0, double a1) {
+  const double m = 0.5 * (a0 + a1);
+  return AngleWindow{cos(a0), sin(a0), cos(a1), sin(a1), cos(m), sin(m),
+                     1.0 / maxv(cos(0.5 * fabs(a1 - a0)), 1e-3)};
+}
+PP_HD Aabb arcBoxW(V3 p, V3 s_A, V3 d_A, const AngleWindow& w) {
+  Aabb b = aabbEmpty();
+  aabbAdd(b, rotateAboutCS(p, s_A, d_A, w.c0, w.s0));
+  aabbAdd(b, rotateAboutCS(p, s_A, d_A, w.c1, w.s1));
+  const V3 c0 = s_A + dot(p - s_A, d_A) * d_A;
+  aabbAdd(b, c0 + w.inv_cos_half * (rotateAboutCS(p, s_A, d_A, w.cm, w.sm) - c0));
+  return b;
+}
+
 PP_HD Aabb arcBox(V3 p, V3 s_A, V3 d_A, double a0, double a1) {
   Aabb b = aabbEmpty();
   const V3 pa = rotateAbout(p, s_A, d_A, a0);

@@ -33,6 +33,61 @@ PP_HD Aabb sweepBox(Aabb b, V3 d, double t) {
   return s;
 }
 
+PP_HD double boxVolume(const Aabb& b) {
+  const V3 e = b.hi - b.lo;
+  return e.x * e.y * e.z;
+}
+
+// Simultaneous traversal of two BVHs: for every pair of leaves whose boxes overlap (A's node
+// boxes first mapped by boxA: posed, swept along a translation or an arc), calls
+// prep(primitive of A) -> data once per primitive of A and leaf pair, then
+// leaf(data, primitive of A, primitive of B). Replaces one root-to-leaf query per primitive
+// of A (the paper's kd-restart per ray) by one walk over both trees.
+constexpr int kPairStack = 2 * kBvhStack;
+template <typename BoxA, typename Prep, typename Leaf>
+PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& prep, Leaf&& leaf) {
+  if (A.num_nodes == 0 || B.num_nodes == 0) return;
+  int sa[kPairStack], sb[kPairStack];
+  int top = 0;
+  sa[top] = 0;
+  sb[top++] = 0;
+  while (top > 0) {
+    --top;
+    const int ia = sa[top], ib = sb[top];
+    const BvhNode& na = A.nodes[ia];
+    const BvhNode& nb = B.nodes[ib];
+    const Aabb ba = boxA(na);
+    if (!aabbOverlap(ba, nb.box)) continue;
+    const bool la = na.left < 0, lb = nb.left < 0;
+    if (la && lb) {
+      for (int i = na.first; i < na.first + na.count; ++i) {
+        const auto data = prep(A.order[i]);
+        for (int j = nb.first; j < nb.first + nb.count; ++j) leaf(data, A.order[i], B.order[j]);
+      }
+      continue;
+    }
+    // Both trees are at most kBvhStack / 2 deep, so this stack cannot overflow.
+    if (!la && (lb || boxVolume(ba) >= boxVolume(nb.box))) {
+      sa[top] = na.left;
+      sb[top++] = ib;
+      sa[top] = na.right;
+      sb[top++] = ib;
+    } else {
+      sa[top] = ia;
+      sb[top++] = nb.left;
+      sa[top] = ia;
+      sb[top++] = nb.right;
+    }
+  }
+}
+
+PP_HD Aabb segmentBox(V3 a, V3 b) {
+  Aabb s = aabbEmpty();
+  aabbAdd(s, a);
+  aabbAdd(s, b);
+  return s;
+}
+
 // ------------------------------------------------------------------ distance kernel (V-A)
 // Smallest t in [0, tmax] such that the object translated by t d (d unit, frame G) touches the
 // area: object vertices against area triangles, area vertices against object triangles, and
@@ -42,70 +97,38 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
   double best = tmax;
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
-  const V3 d_O = rotateInv(X_GO, d);
-  // Object vertices and edges, culled hierarchically: a node whose swept box meets no area
-  // box cannot touch.
-  {
-    int stack[kBvhStack];
-    int top = 0;
-    if (om.vertex_bvh.num_nodes) stack[top++] = 0;
-    while (top > 0) {
-      const BvhNode& n = om.vertex_bvh.nodes[stack[--top]];
-      const Aabb b = sweepBox(transformBox(X_GO, n.box), d, best);
-      if (!bvhAnyOverlap(am.triangle_bvh, b)) continue;
-      if (n.left >= 0) {
-        stack[top++] = n.left;
-        stack[top++] = n.right;
-        continue;
-      }
-      for (int i = n.first; i < n.first + n.count; ++i) {
-        const V3 v = apply(X_GO, om.vertices[om.vertex_bvh.order[i]]);
-        best = bvhRay(am.triangle_bvh, v, d, best, [&](int t) {
-          const int* tri = am.triangles + 3 * t;
-          return rayTriangle(v, d, am.vertices[tri[0]], am.vertices[tri[1]], am.vertices[tri[2]]);
-        });
-      }
-    }
-  }
-  {
-    int stack[kBvhStack];
-    int top = 0;
-    if (om.edge_bvh.num_nodes) stack[top++] = 0;
-    while (top > 0) {
-      const BvhNode& n = om.edge_bvh.nodes[stack[--top]];
-      const Aabb b = sweepBox(transformBox(X_GO, n.box), d, best);
-      if (!bvhAnyOverlap(am.edge_bvh, b)) continue;
-      if (n.left >= 0) {
-        stack[top++] = n.left;
-        stack[top++] = n.right;
-        continue;
-      }
-      for (int i = n.first; i < n.first + n.count; ++i) {
-        const int* e = om.edges + 2 * om.edge_bvh.order[i];
-        const V3 p0 = apply(X_GO, om.vertices[e[0]]), p1 = apply(X_GO, om.vertices[e[1]]);
-        Aabb eb = aabbEmpty();
-        aabbAdd(eb, p0);
-        aabbAdd(eb, p1);
-        bvhQuery(am.edge_bvh, sweepBox(eb, d, best), [&](int j) {
-          const int* f = am.edges + 2 * j;
-          const double t = edgeEdgeTranslation(p0, p1, am.vertices[f[0]], am.vertices[f[1]], d);
-          if (t < best) best = t;
-        });
-      }
-    }
-  }
-  // Area vertices moving by -d against the object's triangles (in O).
-  {
-    const Aabb swept = sweepBox(transformBox(X_GO, om.bounds), d, best);
-    bvhQuery(am.vertex_bvh, swept, [&](int w) {
-      const V3 w_O = applyInv(X_GO, am.vertices[w]);
-      const V3 dir = -d_O;
-      best = bvhRay(om.triangle_bvh, w_O, dir, best, [&](int t) {
-        const int* tri = om.triangles + 3 * t;
-        return rayTriangle(w_O, dir, om.vertices[tri[0]], om.vertices[tri[1]], om.vertices[tri[2]]);
-      });
-    });
-  }
+  auto swept = [&](const BvhNode& n) { return sweepBox(transformBox(X_GO, n.box), d, best); };
+  // Object vertices along d against area triangles.
+  auto posed = [&](int vi) { return apply(X_GO, om.vertices[vi]); };
+  dualTraverse(om.vertex_bvh, am.triangle_bvh, swept, posed, [&](const V3& v, int, int t) {
+    const int* tri = am.triangles + 3 * t;
+    const double h = rayTriangle(v, d, am.vertices[tri[0]], am.vertices[tri[1]], am.vertices[tri[2]]);
+    if (h < best) best = h;
+  });
+  // Object edges against area edges.
+  auto posedEdge = [&](int ei) {
+    const int* e = om.edges + 2 * ei;
+    return Aabb{apply(X_GO, om.vertices[e[0]]), apply(X_GO, om.vertices[e[1]])};  // end points
+  };
+  dualTraverse(om.edge_bvh, am.edge_bvh, swept, posedEdge, [&](const Aabb& pe, int, int fj) {
+    const int* f = am.edges + 2 * fj;
+    const V3 p0 = pe.lo, p1 = pe.hi;
+    const V3 q0 = am.vertices[f[0]], q1 = am.vertices[f[1]];
+    if (!aabbOverlap(sweepBox(segmentBox(p0, p1), d, best), segmentBox(q0, q1))) return;
+    const double h = edgeEdgeTranslation(p0, p1, q0, q1, d);
+    if (h < best) best = h;
+  });
+  // Area vertices moving by -d against the object's triangles, in O.
+  const V3 dir_O = -rotateInv(X_GO, d);
+  auto swept_area = [&](const BvhNode& n) {
+    return sweepBox(transformBoxInv(X_GO, n.box), dir_O, best);
+  };
+  auto inObject = [&](int wi) { return applyInv(X_GO, am.vertices[wi]); };
+  dualTraverse(am.vertex_bvh, om.triangle_bvh, swept_area, inObject, [&](const V3& w, int, int t) {
+    const int* tri = om.triangles + 3 * t;
+    const double h = rayTriangle(w, dir_O, om.vertices[tri[0]], om.vertices[tri[1]], om.vertices[tri[2]]);
+    if (h < best) best = h;
+  });
   return best < tmax ? best : kInf;
 }
 
@@ -113,10 +136,11 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
 // Angle windows traced outward along the circles, like the paper's kd-restart tracing of
 // D(v, A) (Fig. 3): a window's arcs are bounded by small boxes, so only patches the arcs can
 // reach are tested; the search stops once the best angle lies inside the windows done.
-constexpr int kNumAngleWindows = 8;
+// A tilt beyond 90 degrees turns the object over; the tree does not follow it (an object
+// that falls over lands in a pose the other branches and floor points reach directly).
+constexpr int kNumAngleWindows = 5;
 PP_HD double angleWindowEnd(int k) {
-  // 2, 4, 8, 16, 32, 64, 128, 180 degrees
-  const double deg[kNumAngleWindows] = {2, 4, 8, 16, 32, 64, 128, 180};
+  const double deg[kNumAngleWindows] = {4, 12, 30, 60, 90};
   return deg[k] * 0.017453292519943295;
 }
 PP_HD double angleWindowStart(int k) { return k == 0 ? 0.0 : angleWindowEnd(k - 1); }
@@ -129,128 +153,126 @@ struct TiltParams {
 // Angle of an object-frame rotation sigma*theta (sigma = +1 ccw, -1 cw) from a ccw angle.
 PP_HD double directed(double ccw, int sigma) { return sigma > 0 ? ccw : wrapAngle(kTwoPi - ccw); }
 
-// Vertex/surface rotation: smallest angle theta in (min_angle, window limit] by which rotating
-// the object sigma*theta about (s_A, d_A) brings an object vertex onto an area triangle or an
-// area vertex onto an object triangle. kInf when none up to 180 degrees.
+// Box of everything a BVH node's box (already in the frame of the axis) sweeps over a window.
+PP_HD Aabb arcNodeBox(const Aabb& nb, V3 s, V3 d, const AngleWindow& w) {
+  const V3 c = 0.5 * (nb.lo + nb.hi);
+  return aabbInflate(arcBoxW(c, s, d, w), 0.5 * norm(nb.hi - nb.lo));
+}
+
+struct VertexArc {
+  V3 v;      // the vertex, in the frame of the axis
+  Aabb box;  // its arc over the window, inflated by the tolerance
+};
+struct EdgeArc {
+  V3 P0, P1;  // the edge in the axis frame
+  Aabb box;   // its swept arc over the window
+};
+
+// Vertex/surface rotation: smallest angle theta in (min_angle, 90 deg] by which rotating the
+// object sigma*theta about (s_A, d_A) brings an object vertex onto an area triangle or an
+// area vertex onto an object triangle. kInf when none below `limit`.
 PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, const Rigid& X_GO,
-                                V3 s_A, V3 d_A, int sigma, const TiltParams& tp) {
+                                V3 s_A, V3 d_A, int sigma, const TiltParams& tp,
+                                double limit = kInf) {
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
-  double best = kInf;
-  // The object's axis and direction expressed in O for the area-vertex test.
+  double best = limit;
+  // The axis in O, for the area vertices (which turn the other way relative to the object).
   const V3 s_O = applyInv(X_GO, s_A), d_O = rotateInv(X_GO, d_A);
+  const double max_angle = angleWindowEnd(kNumAngleWindows - 1);
+  // v, n, a and the axis (s, dd) are in one frame: G for object vertices, O for area ones.
+  auto accept = [&](double ccw, int sgn, V3 v, V3 n, V3 a, V3 s, V3 dd) {
+    const double th = directed(ccw, sgn);
+    if (th <= tp.min_angle || th >= best || th > max_angle) return;
+    // Entering, not leaving: the vertex approaches the plane from the side it starts on.
+    const double f0 = dot(v - a, n);
+    if (fabs(f0) > tp.tol) {
+      const V3 p = rotateAbout(v, s, dd, sgn * th);
+      const double vel = dot(cross(dd, p - s), n) * sgn;
+      if (vel * f0 > 0) return;
+    }
+    best = th;
+  };
   for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
     const double a0 = sigma * angleWindowStart(k), a1 = sigma * angleWindowEnd(k);
-    // v, n, a and the axis (s, dd) are in one frame: G for object vertices, O for area ones.
-    auto accept = [&](double ccw, int sgn, V3 v, V3 n, V3 a, V3 s, V3 dd) {
-      const double th = directed(ccw, sgn);
-      if (th <= tp.min_angle || th >= best || th > angleWindowEnd(kNumAngleWindows - 1)) return;
-      // Entering, not leaving: the vertex approaches the plane from the side it starts on.
-      const double f0 = dot(v - a, n);
-      if (fabs(f0) > tp.tol) {
-        const V3 p = rotateAbout(v, s, dd, sgn * th);
-        const double vel = dot(cross(dd, p - s), n) * sgn;
-        if (vel * f0 > 0) return;
-      }
-      best = th;
-    };
-    // Object vertices against area triangles.
-    int stack[kBvhStack];
-    int top = 0;
-    if (om.vertex_bvh.num_nodes) stack[top++] = 0;
-    while (top > 0) {
-      const BvhNode& n = om.vertex_bvh.nodes[stack[--top]];
-      const Aabb nb = transformBox(X_GO, n.box);
-      const V3 c = 0.5 * (nb.lo + nb.hi);
-      const double r = 0.5 * norm(nb.hi - nb.lo);
-      if (!bvhAnyOverlap(am.triangle_bvh, aabbInflate(arcBox(c, s_A, d_A, a0, a1), r))) continue;
-      if (n.left >= 0) {
-        stack[top++] = n.left;
-        stack[top++] = n.right;
-        continue;
-      }
-      for (int i = n.first; i < n.first + n.count; ++i) {
-        const V3 v = apply(X_GO, om.vertices[om.vertex_bvh.order[i]]);
-        bvhQuery(am.triangle_bvh, aabbInflate(arcBox(v, s_A, d_A, a0, a1), tp.tol), [&](int t) {
+    const AngleWindow win = angleWindow(a0, a1), win_area = angleWindow(-a0, -a1);
+    dualTraverse(
+        om.vertex_bvh, am.triangle_bvh,
+        [&](const BvhNode& n) { return arcNodeBox(transformBox(X_GO, n.box), s_A, d_A, win); },
+        [&](int vi) {
+          const V3 v = apply(X_GO, om.vertices[vi]);
+          return VertexArc{v, aabbInflate(arcBoxW(v, s_A, d_A, win), tp.tol)};
+        },
+        [&](const VertexArc& va, int, int t) {
+          const V3 v = va.v;
           const int* tri = am.triangles + 3 * t;
           const V3 A = am.vertices[tri[0]], B = am.vertices[tri[1]], C = am.vertices[tri[2]];
+          Aabb tb = segmentBox(A, B);
+          aabbAdd(tb, C);
+          if (!aabbOverlap(va.box, tb)) return;
           double out[2];
           const int m = vertexTriangleAngles(v, s_A, d_A, A, B, C, tp.tol, out);
           for (int j = 0; j < m; ++j) accept(out[j], sigma, v, am.triangle_normals[t], A, s_A, d_A);
         });
-      }
-    }
-    // Area vertices against object triangles: in O the area turns by -sigma*theta.
-    top = 0;
-    if (am.vertex_bvh.num_nodes) stack[top++] = 0;
-    while (top > 0) {
-      const BvhNode& n = am.vertex_bvh.nodes[stack[--top]];
-      const Aabb nb_O = transformBoxInv(X_GO, n.box);
-      const V3 c = 0.5 * (nb_O.lo + nb_O.hi);
-      const double r = 0.5 * norm(nb_O.hi - nb_O.lo);
-      if (!bvhAnyOverlap(om.triangle_bvh, aabbInflate(arcBox(c, s_O, d_O, -a0, -a1), r))) continue;
-      if (n.left >= 0) {
-        stack[top++] = n.left;
-        stack[top++] = n.right;
-        continue;
-      }
-      for (int i = n.first; i < n.first + n.count; ++i) {
-        const V3 w = applyInv(X_GO, am.vertices[am.vertex_bvh.order[i]]);
-        bvhQuery(om.triangle_bvh, aabbInflate(arcBox(w, s_O, d_O, -a0, -a1), tp.tol), [&](int t) {
+    dualTraverse(
+        am.vertex_bvh, om.triangle_bvh,
+        [&](const BvhNode& n) { return arcNodeBox(transformBoxInv(X_GO, n.box), s_O, d_O, win_area); },
+        [&](int wi) {
+          const V3 w = applyInv(X_GO, am.vertices[wi]);
+          return VertexArc{w, aabbInflate(arcBoxW(w, s_O, d_O, win_area), tp.tol)};
+        },
+        [&](const VertexArc& va, int, int t) {
+          const V3 w = va.v;
           const int* tri = om.triangles + 3 * t;
           const V3 A = om.vertices[tri[0]], B = om.vertices[tri[1]], C = om.vertices[tri[2]];
+          Aabb tb = segmentBox(A, B);
+          aabbAdd(tb, C);
+          if (!aabbOverlap(va.box, tb)) return;
           double out[2];
           const int m = vertexTriangleAngles(w, s_O, d_O, A, B, C, tp.tol, out);
           for (int j = 0; j < m; ++j) accept(out[j], -sigma, w, om.triangle_normals[t], A, s_O, d_O);
         });
-      }
-    }
   }
-  return best;
+  return best < limit ? best : kInf;
 }
 
 // Edge/edge rotation: smallest angle by which rotating the object sigma*theta about (s_A, d_A)
-// brings an object edge onto an area edge (surfaces of revolution, Table I). kInf when none.
+// brings an object edge onto an area edge (surfaces of revolution, Table I). kInf when none
+// below `limit`.
 PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Rigid& X_GO, V3 s_A,
-                           V3 d_A, int sigma, const TiltParams& tp) {
+                           V3 d_A, int sigma, const TiltParams& tp, double limit = kInf) {
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
-  double best = kInf;
+  double best = limit;
+  const AxisFrame frame = axisFrame(s_A, d_A);
+  const double max_angle = angleWindowEnd(kNumAngleWindows - 1);
   for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
     const double a0 = sigma * angleWindowStart(k), a1 = sigma * angleWindowEnd(k);
-    int stack[kBvhStack];
-    int top = 0;
-    if (om.edge_bvh.num_nodes) stack[top++] = 0;
-    while (top > 0) {
-      const BvhNode& n = om.edge_bvh.nodes[stack[--top]];
-      const Aabb nb = transformBox(X_GO, n.box);
-      const V3 c = 0.5 * (nb.lo + nb.hi);
-      const double r = 0.5 * norm(nb.hi - nb.lo);
-      if (!bvhAnyOverlap(am.edge_bvh, aabbInflate(arcBox(c, s_A, d_A, a0, a1), r))) continue;
-      if (n.left >= 0) {
-        stack[top++] = n.left;
-        stack[top++] = n.right;
-        continue;
-      }
-      for (int i = n.first; i < n.first + n.count; ++i) {
-        const int* e = om.edges + 2 * om.edge_bvh.order[i];
-        const V3 p0 = apply(X_GO, om.vertices[e[0]]), p1 = apply(X_GO, om.vertices[e[1]]);
-        // The swept segment lies in the convex hull of its end points' arcs.
-        Aabb sb = arcBox(p0, s_A, d_A, a0, a1);
-        aabbMerge(sb, arcBox(p1, s_A, d_A, a0, a1));
-        bvhQuery(am.edge_bvh, aabbInflate(sb, tp.tol), [&](int j) {
-          const int* f = am.edges + 2 * j;
+    const AngleWindow win = angleWindow(a0, a1);
+    dualTraverse(
+        om.edge_bvh, am.edge_bvh,
+        [&](const BvhNode& n) { return arcNodeBox(transformBox(X_GO, n.box), s_A, d_A, win); },
+        [&](int ei) {
+          const int* e = om.edges + 2 * ei;
+          const V3 p0 = apply(X_GO, om.vertices[e[0]]), p1 = apply(X_GO, om.vertices[e[1]]);
+          // The swept segment lies in the convex hull of its end points' arcs.
+          Aabb sb = arcBoxW(p0, s_A, d_A, win);
+          aabbMerge(sb, arcBoxW(p1, s_A, d_A, win));
+          return EdgeArc{toAxis(frame, p0), toAxis(frame, p1), aabbInflate(sb, tp.tol)};
+        },
+        [&](const EdgeArc& ea, int, int fj) {
+          const int* f = am.edges + 2 * fj;
+          const V3 q0 = am.vertices[f[0]], q1 = am.vertices[f[1]];
+          if (!aabbOverlap(ea.box, segmentBox(q0, q1))) return;
           double out[4];
-          const int m = edgeEdgeAngles(p0, p1, am.vertices[f[0]], am.vertices[f[1]], s_A, d_A, out);
+          const int m = edgeEdgeAnglesAxis(ea.P0, ea.P1, toAxis(frame, q0), toAxis(frame, q1), out);
           for (int q = 0; q < m; ++q) {
             const double th = directed(out[q], sigma);
-            if (th > tp.min_angle && th < best && th <= angleWindowEnd(kNumAngleWindows - 1)) best = th;
+            if (th > tp.min_angle && th < best && th <= max_angle) best = th;
           }
         });
-      }
-    }
   }
-  return best;
+  return best < limit ? best : kInf;
 }
 
 // ------------------------------------------------------------------ contact kernel (V-B)
@@ -276,6 +298,7 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   const double cd2 = g.collision_distance * g.collision_distance;
   V3 sum = v3(0, 0, 0), nsum = v3(0, 0, 0);
   int count = 0;
+  double gap = kInf;
   for (int k = g.start[cell]; k < g.start[cell + 1]; ++k) {
     const int i = g.items[k];
     const V3 a = area.mesh.sphere_centres[i];
@@ -285,8 +308,13 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
     sum = sum + a;
     nsum = nsum + na;
     ++count;
+    // Separation along the area's normal: zero for touching surfaces, whatever the lateral
+    // offset of the two sphere lattices.
+    gap = minv(gap, fabs(dot(s_G - a, na)));
   }
-  if (count == 0) return out;
+  // Near misses (a gap up to the collision distance) are not contacts: the tree keeps
+  // rotating until real contacts hold the object (the paper counts every colliding sphere).
+  if (count == 0 || gap > g.contact_gap) return out;
   out.p = (1.0 / count) * sum;
   V3 no = -n_G;
   if (dot(no, com_G - s_G) < 0) no = -no;

@@ -25,6 +25,7 @@ struct GridView {
   double x0, y0, cell;
   int nx, ny;
   double collision_distance;
+  double contact_gap;  // max separation along the area normal of a contact
   const int* start;
   const int* items;
   const double* max_z;

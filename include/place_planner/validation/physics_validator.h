@@ -8,7 +8,7 @@
 //  - area: one static btBvhTriangleMeshShape of all area triangles, friction 1.0, margin `margin`
 //    (with the default margin 0 objects crept down slopes they should stick to);
 //  - object: a btCompoundShape of small btConvexHullShape pieces, each a group of neighbouring
-//    triangles of similar normal, thickened inwards by `piece_thickness` (a GImpact mesh
+//    triangles of similar normal, thickened inwards up to `piece_thickness` (a GImpact mesh
 //    jitters on a triangle mesh; small hulls rest still), margins `margin` (1 mm: 0.5 mm gave
 //    wrong static friction) and inset by the two margins so that the true surfaces touch (a cube
 //    on a table rests at its geometric height, not 2 mm above), friction mu (Bullet multiplies the two coefficients: mu x 1.0);
@@ -29,7 +29,7 @@ struct ValidatorConfig {
   double time_step = 1.0 / 480.0;        // s, fixed step
   int solver_iterations = 30;
   double margin = 0.001;                 // m, convex hull margins (1 mm, see above)
-  double piece_thickness = 0.002;        // m, inward thickening of each surface piece
+  double piece_thickness = 0.01;         // m, inward thickening of each piece (less in thin parts)
   int piece_max_triangles = 12;          // triangles per convex piece at most
   double piece_max_normal_deg = 40.0;    // piece triangles' normals within this of the seed's
   double piece_max_size = 0.03;          // m, largest distance of a piece triangle from its seed

@@ -1,0 +1,234 @@
+// The planner end to end: analytic scenes with known answers, real meshes from ../shared/data.
+#include <random>
+
+#include "place_planner/mesh_io.h"
+#include "place_planner/planner.h"
+#include "test_helpers.h"
+
+using namespace place_planner;
+
+namespace {
+
+// Posed vertices of a candidate.
+std::vector<Eigen::Vector3d> posed(const Mesh& m, const Candidate& c) {
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& v : m.vertices) out.push_back(c.X_WO * v);
+  return out;
+}
+double minZ(const Mesh& m, const Candidate& c) {
+  double z = 1e9;
+  for (const auto& p : posed(m, c)) z = std::min(z, p.z());
+  return z;
+}
+const Candidate* bestStable(const PlanResult& r) {
+  return !r.candidates.empty() && r.candidates.front().stable ? &r.candidates.front() : nullptr;
+}
+int countStable(const PlanResult& r) {
+  int n = 0;
+  for (const auto& c : r.candidates) n += c.stable;
+  return n;
+}
+// Deletes about `fraction` of the triangles in connected patches (unobserved regions).
+Mesh withHoles(const Mesh& m, double fraction, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<bool> drop(m.triangles.size(), false);
+  size_t target = static_cast<size_t>(fraction * m.triangles.size()), dropped = 0;
+  while (dropped < target) {
+    const Eigen::Vector3d c = m.vertices[m.triangles[rng() % m.triangles.size()][0]];
+    const double radius = 0.01;
+    for (size_t t = 0; t < m.triangles.size() && dropped < target; ++t)
+      if (!drop[t] && (m.vertices[m.triangles[t][0]] - c).norm() < radius) {
+        drop[t] = true;
+        ++dropped;
+      }
+  }
+  std::vector<std::vector<int>> polys;
+  for (size_t t = 0; t < m.triangles.size(); ++t)
+    if (!drop[t]) polys.push_back({m.triangles[t][0], m.triangles[t][1], m.triangles[t][2]});
+  return buildMesh(m.vertices, polys, "holey");
+}
+
+}  // namespace
+
+TEST(Planner, CubeOnTableRestsFaceDown) {
+  const Mesh cube = scenes::box(0.1, 0.1, 0.1, {0, 0, 0.05});
+  const Mesh table = scenes::table();
+  PlannerConfig cfg;
+  const PlanResult r = Planner().plan(cube, table, cfg);
+  const Candidate* c = bestStable(r);
+  ASSERT_NE(c, nullptr);
+  EXPECT_GE(c->quality, 0.9);
+  // Face down: one of the cube's axes is vertical.
+  double best_axis = 0;
+  for (int i = 0; i < 3; ++i) best_axis = std::max(best_axis, std::abs(c->X_WO.linear().col(i).z()));
+  EXPECT_GT(best_axis, std::cos(1.0 * M_PI / 180));
+  EXPECT_NEAR(minZ(cube, *c), 0.0, 0.002);  // bottom on the table top
+  // Intermediate poses: the pre-placement pose above the floor point first, the goal last.
+  ASSERT_GE(c->intermediate_poses.size(), 2u);
+  EXPECT_TRUE(c->intermediate_poses.back().isApprox(c->X_WO, 1e-12));
+  const Eigen::Vector3d com0 = c->intermediate_poses.front() * cube.properties.center_of_mass;
+  EXPECT_NEAR(com0.x(), c->floor_point_W.x(), 1e-9);
+  EXPECT_NEAR(com0.y(), c->floor_point_W.y(), 1e-9);
+  EXPECT_GT(com0.z(), c->floor_point_W.z() + 0.05);
+  EXPECT_EQ(r.stats.floor_points_total, static_cast<int>(r.floor_points_W.size()));
+  EXPECT_GT(r.stats.tree_nodes, 0);
+  EXPECT_GE(r.stats.first_stable_ms, 0.0);
+}
+
+TEST(Planner, CubeOnGentleSlopeIsStable) {
+  const Mesh cube = scenes::box(0.1, 0.1, 0.1, {0, 0, 0.05});
+  const PlanResult r = Planner().plan(cube, scenes::plane(1.0, 1.0, 5.0), PlannerConfig());
+  const Candidate* c = bestStable(r);
+  ASSERT_NE(c, nullptr);
+  // A face lies on the slope: a cube axis parallel to the slope's normal.
+  const Eigen::Vector3d n(0, -std::sin(5 * M_PI / 180), std::cos(5 * M_PI / 180));
+  double best_axis = 0;
+  for (int i = 0; i < 3; ++i) best_axis = std::max(best_axis, std::abs(c->X_WO.linear().col(i).dot(n)));
+  EXPECT_GT(best_axis, std::cos(1.0 * M_PI / 180));
+}
+
+TEST(Planner, CubeOnSteepSlopeIsNotStable) {
+  // 20 degrees > atan(0.2) = 11.3: nothing holds the cube on the slope.
+  const Mesh cube = scenes::box(0.1, 0.1, 0.1, {0, 0, 0.05});
+  const PlanResult r = Planner().plan(cube, scenes::plane(1.0, 1.0, 20.0), PlannerConfig());
+  EXPECT_EQ(countStable(r), 0);
+}
+
+TEST(Planner, CubeInVTroughRestsOnBothSides) {
+  const Mesh cube = scenes::box(0.1, 0.1, 0.1, {0, 0, 0.05});
+  const PlanResult r = Planner().plan(cube, scenes::vTrough(0.6, 20.0), PlannerConfig());
+  const Candidate* c = bestStable(r);
+  ASSERT_NE(c, nullptr);
+  bool left = false, right = false;
+  for (const auto& p : c->contacts) {
+    left |= p.p_W.y() < -0.005;
+    right |= p.p_W.y() > 0.005;
+  }
+  EXPECT_TRUE(left && right) << "stable cube must touch both slopes";
+  // At the bottom: its centre of mass over the valley.
+  EXPECT_LT(std::abs((c->X_WO * cube.properties.center_of_mass).y()), 0.05);
+}
+
+TEST(Planner, CylinderLyingIsNotStableStandingIs) {
+  const Mesh cyl = scenes::cylinder(0.04, 0.12, 64);
+  PlannerConfig cfg;
+  cfg.orientation = OrientationMode::kKeep;
+  cfg.floor_point_spacing = 0.2;
+  // Lying: axis horizontal. No stable candidate may keep it lying.
+  cfg.start_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()));
+  PlanResult r = Planner().plan(cyl, scenes::table(), cfg);
+  for (const auto& c : r.candidates)
+    if (c.stable) EXPECT_GT(std::abs(c.X_WO.linear().col(2).z()), 0.7) << "lying cylinder reported stable";
+  // Standing on its base.
+  cfg.start_orientation = Eigen::Quaterniond::Identity();
+  r = Planner().plan(cyl, scenes::table(), cfg);
+  const Candidate* c = bestStable(r);
+  ASSERT_NE(c, nullptr);
+  EXPECT_GT(std::abs(c->X_WO.linear().col(2).z()), 0.999);
+  EXPECT_NEAR(minZ(cyl, *c), 0.0, 0.002);
+}
+
+TEST(Planner, StableCandidatesDoNotPenetrate) {
+  for (const std::string obj : {"cube", "mug", "plate"}) {
+    const Mesh m = scenes::byName(obj);
+    PlannerConfig cfg;
+    const PlanResult r = Planner().plan(m, scenes::table(), cfg);
+    ASSERT_GT(countStable(r), 0) << obj;
+    for (const auto& c : r.candidates)
+      if (c.stable) EXPECT_GE(minZ(m, c), -r.stats.sphere_radius) << obj;
+  }
+}
+
+TEST(Planner, DeterministicAcrossThreadCounts) {
+  const Mesh mug = scenes::mug();
+  PlannerConfig cfg;
+  cfg.orientation = OrientationMode::kAllAxes;
+  cfg.threads = 1;
+  const PlanResult a = Planner().plan(mug, scenes::binderStack(), cfg);
+  cfg.threads = 2;
+  const PlanResult b = Planner().plan(mug, scenes::binderStack(), cfg);
+  ASSERT_EQ(a.candidates.size(), b.candidates.size());
+  ASSERT_GT(a.candidates.size(), 0u);
+  for (size_t i = 0; i < a.candidates.size(); ++i) {
+    EXPECT_TRUE(a.candidates[i].X_WO.isApprox(b.candidates[i].X_WO, 1e-12));
+    EXPECT_EQ(a.candidates[i].quality, b.candidates[i].quality);
+  }
+  EXPECT_EQ(a.stats.tree_nodes, b.stats.tree_nodes);
+}
+
+TEST(Planner, CancelAndBudgetReturnWhatTheyHave) {
+  const Mesh mug = scenes::mug();
+  PlannerConfig cfg;
+  cfg.floor_point_spacing = 0.02;
+  int calls = 0;
+  const PlanResult r = Planner().plan(mug, scenes::table(), cfg, [&](const Progress& p) {
+    EXPECT_LE(p.floor_points_done, p.floor_points_total);
+    return ++calls < 20;
+  });
+  EXPECT_TRUE(r.cancelled);
+  EXPECT_LT(r.stats.floor_points_done, r.stats.floor_points_total);
+  cfg.time_budget_ms = 1;
+  EXPECT_TRUE(Planner().plan(mug, scenes::table(), cfg).timed_out);
+  cfg.friction = -1;
+  EXPECT_THROW(Planner().plan(mug, scenes::table(), cfg), std::invalid_argument);
+}
+
+TEST(Planner, MergesNearbyPoses) {
+  PlannerConfig cfg;
+  cfg.floor_point_spacing = 0.05;
+  const PlanResult r = Planner().plan(scenes::byName("cube"), scenes::table(), cfg);
+  for (size_t i = 0; i < r.candidates.size(); ++i)
+    for (size_t j = i + 1; j < r.candidates.size(); ++j) {
+      const double d = (r.candidates[i].X_WO.translation() - r.candidates[j].X_WO.translation()).norm();
+      const double a = Eigen::AngleAxisd(r.candidates[i].X_WO.linear().transpose() * r.candidates[j].X_WO.linear()).angle();
+      EXPECT_FALSE(d < cfg.merge_distance && a < cfg.merge_angle_deg * M_PI / 180);
+    }
+}
+
+// ------------------------------------------------------------------ real meshes
+TEST(PlannerShared, PlateStandsInDishRack) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh plate = loadMesh(test::sharedData() + "/objects/plate_ycb029_1k.ply");
+  const Mesh rack = loadMesh(test::sharedData() + "/areas/dish_rack.ply");
+  PlannerConfig cfg;
+  cfg.floor_point_spacing = 0.03;
+  const PlanResult r = Planner().plan(plate, rack, cfg);
+  const Candidate* c = bestStable(r);
+  ASSERT_NE(c, nullptr);
+  // The plate's normal (k3) within 30 degrees of horizontal: standing between the pegs.
+  const Eigen::Vector3d n = c->X_WO.linear() * plate.properties.principal_axes.col(2);
+  EXPECT_LT(std::abs(n.z()), std::sin(30 * M_PI / 180)) << "normal " << n.transpose();
+}
+
+TEST(PlannerShared, MarkerGoesIntoPenCup) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh marker = loadMesh(test::sharedData() + "/objects/marker_ycb040_1k.ply");
+  const Mesh cup = loadMesh(test::sharedData() + "/areas/pen_cup_ycb065j_1k.ply");
+  PlannerConfig cfg;
+  const PlanResult r = Planner().plan(marker, cup, cfg);
+  const Candidate* c = bestStable(r);
+  ASSERT_NE(c, nullptr);
+  EXPECT_LT(minZ(marker, *c), cup.properties.bounds_max.z() - 0.01) << "lowest point below the rim";
+}
+
+TEST(PlannerShared, MugOnBooksAndInBin) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  for (const std::string area : {"books_stack", "bin"}) {
+    const PlanResult r = Planner().plan(mug, loadMesh(test::sharedData() + "/areas/" + area + ".ply"), PlannerConfig());
+    EXPECT_GT(countStable(r), 0) << area;
+  }
+}
+
+TEST(PlannerShared, MugWithHolesStillPlaced) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh holey = withHoles(mug, 0.10, 3);
+  ASSERT_LT(holey.triangles.size(), mug.triangles.size() * 0.92);
+  const Mesh table = loadMesh(test::sharedData() + "/areas/table.ply");
+  const PlanResult r = Planner().plan(holey, table, PlannerConfig());
+  const Candidate* c = bestStable(r);
+  ASSERT_NE(c, nullptr);
+  // Validated on the full mesh: resting on the table, not in it.
+  EXPECT_NEAR(minZ(mug, *c), 0.0, 0.003);
+}

@@ -1,0 +1,260 @@
+// Each step of the planner on hand-checkable cases.
+#include "place_planner/backend.h"
+#include "place_planner/contact_points.h"
+#include "place_planner/floor_points.h"
+#include "place_planner/kernels/geometry.h"
+#include "place_planner/pre_orientation.h"
+#include "place_planner/quality.h"
+#include "place_planner/stability.h"
+#include "place_planner/tilt_axis.h"
+#include "test_helpers.h"
+
+using namespace place_planner;
+
+namespace {
+constexpr double kAngleTol = 1e-9;  // closed forms: exact up to rounding
+double deg(double rad) { return rad * 180.0 / M_PI; }
+}  // namespace
+
+TEST(TiltAngle, VertexOntoPlaneMatchesClosedForm) {
+  // v = (1, 0, 0) about +y through the origin onto the plane z = -0.5: z(theta) = -sin(theta).
+  const V3 A = v3(-5, -5, -0.5), B = v3(5, -5, -0.5), C = v3(0, 5, -0.5);
+  double out[2];
+  const int n = vertexTriangleAngles(v3(1, 0, 0), v3(0, 0, 0), v3(0, 1, 0), A, B, C, 1e-9, out);
+  ASSERT_EQ(n, 2);
+  const double lo = std::min(out[0], out[1]), hi = std::max(out[0], out[1]);
+  EXPECT_NEAR(lo, M_PI / 6, kAngleTol);      // asin(0.5)
+  EXPECT_NEAR(hi, 5 * M_PI / 6, kAngleTol);  // the circle leaves the plane again
+  // Outside the patch: a small triangle far away in x gives no angle.
+  EXPECT_EQ(vertexTriangleAngles(v3(1, 0, 0), v3(0, 0, 0), v3(0, 1, 0), v3(3, -1, -0.5),
+                                 v3(4, -1, -0.5), v3(3.5, 1, -0.5), 1e-9, out),
+            0);
+  // A plane the circle cannot reach.
+  EXPECT_EQ(vertexTriangleAngles(v3(1, 0, 0), v3(0, 0, 0), v3(0, 1, 0), v3(-5, -5, -2),
+                                 v3(5, -5, -2), v3(0, 5, -2), 1e-9, out),
+            0);
+}
+
+TEST(TiltAngle, EdgeEdgeCylinder) {
+  const V3 P0 = v3(1, 0, -1), P1 = v3(1, 0, 1);  // parallel to the axis: cylinder r = 1
+  EXPECT_EQ(revolutionOf(P0, P1).kind, 1);
+  double out[4];
+  const int n = edgeEdgeAnglesAxis(P0, P1, v3(0.6, -2, 0), v3(0.6, 2, 0), out);
+  ASSERT_EQ(n, 2);
+  const double lo = std::min(out[0], out[1]), hi = std::max(out[0], out[1]);
+  EXPECT_NEAR(lo, std::atan2(0.8, 0.6), kAngleTol);
+  EXPECT_NEAR(hi, 2 * M_PI - std::atan2(0.8, 0.6), kAngleTol);
+}
+
+TEST(TiltAngle, EdgeEdgeCone) {
+  const V3 P0 = v3(0, 0, 0), P1 = v3(1, 0, 1);  // meets the axis: cone r = z
+  EXPECT_EQ(revolutionOf(P0, P1).kind, 2);
+  double out[4];
+  const int n = edgeEdgeAnglesAxis(P0, P1, v3(0, -2, 0.5), v3(0, 2, 0.5), out);
+  ASSERT_EQ(n, 2);
+  EXPECT_NEAR(std::min(out[0], out[1]), M_PI / 2, kAngleTol);
+  EXPECT_NEAR(std::max(out[0], out[1]), 3 * M_PI / 2, kAngleTol);
+}
+
+TEST(TiltAngle, EdgeEdgeHyperboloid) {
+  const V3 P0 = v3(1, -1, -1), P1 = v3(1, 1, 1);  // skew: r^2 = 1 + z^2
+  EXPECT_EQ(revolutionOf(P0, P1).kind, 3);
+  double out[4];
+  const int n = edgeEdgeAnglesAxis(P0, P1, v3(-3, 0, 1), v3(3, 0, 1), out);
+  ASSERT_EQ(n, 2);
+  // From (1, 1) at z = 1 to (+-sqrt 2, 0): -45 and +135 degrees.
+  EXPECT_NEAR(deg(std::min(out[0], out[1])), 135.0, 1e-7);
+  EXPECT_NEAR(deg(std::max(out[0], out[1])), 315.0, 1e-7);
+}
+
+TEST(TiltAngle, EdgeEdgeAnnulus) {
+  const V3 P0 = v3(1, 0, 0), P1 = v3(2, 0, 0);  // horizontal: annulus 1 <= r <= 2
+  EXPECT_EQ(revolutionOf(P0, P1).kind, 0);
+  double out[4];
+  const int n = edgeEdgeAnglesAxis(P0, P1, v3(0, 1.5, -1), v3(0, 1.5, 1), out);
+  ASSERT_EQ(n, 1);
+  EXPECT_NEAR(out[0], M_PI / 2, kAngleTol);
+  // A fixed segment outside the annulus' radii never meets it.
+  EXPECT_EQ(edgeEdgeAnglesAxis(P0, P1, v3(0, 2.5, -1), v3(0, 2.5, 1), out), 0);
+}
+
+TEST(TiltAngle, EdgeEdgeGeneralAxisAgreesWithRotation) {
+  // Off-origin axis: q0q1 is built through a point of p0p1 turned by 0.7 rad, so 0.7 must be
+  // among the angles, and every angle returned makes the segments' lines meet.
+  const V3 s = v3(0.3, -0.2, 0.1), d = normalized(v3(0.2, 0.1, 1));
+  const V3 p0 = v3(1.0, 0.1, 0.0), p1 = v3(1.2, 0.4, 0.5);
+  const V3 m = rotateAbout(0.5 * (p0 + p1), s, d, 0.7);
+  const V3 q0 = m - v3(0.3, 0.1, -0.2), q1 = m + v3(0.3, 0.1, -0.2);
+  double out[4];
+  const int n = edgeEdgeAngles(p0, p1, q0, q1, s, d, out);
+  ASSERT_GE(n, 1);
+  bool found = false;
+  for (int i = 0; i < n; ++i) found |= std::abs(out[i] - 0.7) < 1e-9;
+  EXPECT_TRUE(found);
+  for (int i = 0; i < n; ++i) {
+    const V3 a = rotateAbout(p0, s, d, out[i]), b = rotateAbout(p1, s, d, out[i]);
+    // Distance between the segments' lines at the solution is zero.
+    const V3 nn = cross(b - a, q1 - q0);
+    EXPECT_NEAR(dot(q0 - a, normalized(nn)), 0.0, 1e-9);
+  }
+}
+
+TEST(FirstContact, CubeAbovePlaneAndEdgeCrossing) {
+  const Mesh cube = scenes::box(0.1, 0.1, 0.1);
+  const Mesh plane = scenes::plane(1, 1);
+  const ObjectModel om = buildObjectModel(cube, 0.002);
+  const AreaModel am = buildAreaModel(plane, {0, 0, -1}, 0.003, 0.005, 0.005);
+  Rigid X{{1, 0, 0, 0, 1, 0, 0, 0, 1}, v3(0.1, 0.05, 0.35)};  // bottom at z = 0.3
+  EXPECT_NEAR(firstContactDistance(view(om), view(am), X, v3(0, 0, -1), 1.0), 0.3, 1e-12);
+  EXPECT_GE(firstContactDistance(view(om), view(am), X, v3(0, 0, -1), 0.2), kInf);  // beyond tmax
+  // Edge against edge: a segment moving down onto a crossing segment.
+  EXPECT_NEAR(edgeEdgeTranslation(v3(-1, 0, 1), v3(1, 0, 1), v3(0, -1, 0), v3(0, 1, 0), v3(0, 0, -1)),
+              1.0, 1e-12);
+  EXPECT_GE(edgeEdgeTranslation(v3(-1, 0, 1), v3(1, 0, 1), v3(2, -1, 0), v3(2, 1, 0), v3(0, 0, -1)), kInf);
+}
+
+TEST(FloorPoints, GridOverTableAndLowestN) {
+  const AreaModel am = buildAreaModel(scenes::table(), {0, 0, -1}, 0.003, 0.006, 0.006);
+  FloorPointParams p;
+  p.d_vis = v3(0, 0, -1);
+  p.spacing = 0.1;
+  const FloorPoints fp = floorPoints(am, p);
+  EXPECT_EQ(fp.points.size(), 11u * 9u);  // 1.0 x 0.8 m at 0.1 m
+  for (const V3& q : fp.points) EXPECT_NEAR(q.z, 0.0, 1e-9);  // the top, not the underside
+  // Box-like area: the lowest points are the inside bottom, not the rim.
+  const AreaModel box = buildAreaModel(scenes::openBox(), {0, 0, -1}, 0.003, 0.006, 0.006);
+  p.spacing = 0.02;
+  p.lowest_n = 10;
+  const FloorPoints low = floorPoints(box, p);
+  ASSERT_EQ(low.points.size(), 10u);
+  for (const V3& q : low.points) EXPECT_NEAR(q.z, 0.01, 1e-9);
+  // Small areas refine the spacing until min_points rays hit.
+  p.lowest_n = 0;
+  p.spacing = 1.0;
+  p.min_points = 16;
+  EXPECT_GE(floorPoints(am, p).points.size(), 16u);
+}
+
+TEST(PreOrientation, PrincipalAxisAlongApproach) {
+  const Mesh pen = scenes::pen();
+  // Lying pen: k1 along z in its frame; a start orientation laying it along x.
+  const Eigen::Matrix3d R_start = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const auto R = preOrientations(pen.properties, R_start, Eigen::Vector3d(0, 0, -1), OrientationMode::kPrincipalAxis);
+  ASSERT_EQ(R.size(), 1u);
+  EXPECT_NEAR(std::abs((R[0] * pen.properties.k1()).z()), 1.0, 1e-9);
+  EXPECT_EQ(preOrientations(pen.properties, R_start, Eigen::Vector3d(0, 0, -1), OrientationMode::kAllAxes).size(), 6u);
+  EXPECT_TRUE(preOrientations(pen.properties, R_start, Eigen::Vector3d(0, 0, -1), OrientationMode::kKeep)[0].isApprox(R_start));
+}
+
+TEST(TiltAxis, LayoutsAndAxes) {
+  const Eigen::Vector3d dg(0, 0, -1), com(0, 0, 0.1);
+  std::vector<ContactPoint> one = {{{0.01, 0, 0}, {0, 0, 1}}};
+  // One contact: k1 x d_g.
+  TiltAxis a = tiltAxis(one, com, Eigen::Vector3d(1, 0, 0), dg, 1e-3, 0);
+  EXPECT_EQ(a.layout, ContactLayout::kSingle);
+  EXPECT_NEAR(std::abs(a.d_A.y()), 1.0, 1e-12);
+  // k1 parallel to gravity: (contact - com) x d_g.
+  a = tiltAxis(one, com, Eigen::Vector3d(0, 0, 1), dg, 1e-3, 0);
+  EXPECT_NEAR(std::abs(a.d_A.y()), 1.0, 1e-12);
+  // Both parallel: a reproducible axis perpendicular to gravity.
+  std::vector<ContactPoint> below = {{{0, 0, 0}, {0, 0, 1}}};
+  a = tiltAxis(below, com, Eigen::Vector3d(0, 0, 1), dg, 1e-3, 42);
+  EXPECT_NEAR(a.d_A.z(), 0.0, 1e-12);
+  EXPECT_TRUE(a.d_A.isApprox(tiltAxis(below, com, Eigen::Vector3d(0, 0, 1), dg, 1e-3, 42).d_A));
+  // Collinear contacts: their line.
+  std::vector<ContactPoint> line = {{{0, 0, 0}, {0, 0, 1}}, {{0.05, 0.05, 0}, {0, 0, 1}}, {{0.1, 0.1, 0}, {0, 0, 1}}};
+  a = tiltAxis(line, com, Eigen::Vector3d(1, 0, 0), dg, 1e-3, 0);
+  EXPECT_EQ(a.layout, ContactLayout::kCollinear);
+  EXPECT_NEAR(std::abs(a.d_A.dot(Eigen::Vector3d(1, 1, 0).normalized())), 1.0, 1e-9);
+  line.push_back({{0.1, 0, 0}, {0, 0, 1}});
+  EXPECT_EQ(tiltAxis(line, com, Eigen::Vector3d(1, 0, 0), dg, 1e-3, 0).layout, ContactLayout::kIndependent);
+}
+
+TEST(Stability, SquareFootprintQualityAndFailure) {
+  // Unit-square footprint (0.1 m), centre of mass 0.05 m above its centre: a cube lying flat.
+  std::vector<ContactPoint> sq;
+  for (double x : {-0.05, 0.05})
+    for (double y : {-0.05, 0.05}) sq.push_back({{x, y, 0}, {0, 0, 1}});
+  StabilityParams p;
+  Stability s = evaluateStability(sq, Eigen::Vector3d(0, 0, 0.05), p);
+  EXPECT_TRUE(s.planar);
+  EXPECT_TRUE(s.stable);
+  EXPECT_NEAR(s.quality, 1.0 - 1.0 / 17.0, 1e-9);  // s = (0.05/0.1)^2/4 = 1/16
+  EXPECT_GE(s.quality, 0.9);
+  EXPECT_NEAR(s.tipping_angle, M_PI / 4, 1e-9);
+  EXPECT_EQ(s.hull.size(), 4u);
+  // Centre of mass beyond the edge x = 0.05: tips towards +x about the farthest contact.
+  s = evaluateStability(sq, Eigen::Vector3d(0.08, 0, 0.05), p);
+  EXPECT_FALSE(s.stable);
+  EXPECT_EQ(s.failure, Failure::kTip);
+  EXPECT_GT(s.d_f.x(), 0.99);
+  EXPECT_NEAR(s.pivot.x(), 0.05, 1e-12);
+  // Half way to the edge: Q = 1 - 0.5 - 1/17.
+  s = evaluateStability(sq, Eigen::Vector3d(0.025, 0, 0.05), p);
+  EXPECT_NEAR(s.quality, 0.5 - 1.0 / 17.0, 1e-9);
+}
+
+TEST(Stability, SlopeFrictionAndEquilibrium) {
+  StabilityParams p;  // mu = 0.2: friction angle 11.3 degrees
+  for (double slope_deg : {5.0, 20.0}) {
+    const double a = slope_deg * M_PI / 180;
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    std::vector<ContactPoint> sq;
+    for (double x : {-0.05, 0.05})
+      for (double y : {-0.05, 0.05}) sq.push_back({R * Eigen::Vector3d(x, y, 0), R * Eigen::Vector3d(0, 0, 1)});
+    const Stability s = evaluateStability(sq, R * Eigen::Vector3d(0, 0, 0.05), p);
+    EXPECT_TRUE(s.planar);
+    EXPECT_EQ(s.stable, slope_deg < 11.3) << slope_deg;
+    if (!s.stable) {
+      EXPECT_EQ(s.failure, Failure::kSlide);
+      EXPECT_LT(s.d_f.z(), 0.0);  // down the slope
+    }
+  }
+  // Equilibrium (non-planar case): a block in a V of two 20 degree slopes is held.
+  std::vector<ContactPoint> v = {
+      {{0, -0.05, 0.0}, Eigen::Vector3d(0, std::sin(0.35), std::cos(0.35))},
+      {{0, 0.05, 0.0}, Eigen::Vector3d(0, -std::sin(0.35), std::cos(0.35))},
+      {{0.05, -0.05, 0.0}, Eigen::Vector3d(0, std::sin(0.35), std::cos(0.35))},
+      {{0.05, 0.05, 0.0}, Eigen::Vector3d(0, -std::sin(0.35), std::cos(0.35))}};
+  EXPECT_TRUE(equilibrium(v, Eigen::Vector3d(0.025, 0, 0.05), Eigen::Vector3d(0, 0, -1), 0.2, 0.05));
+  // One side alone cannot hold it at mu = 0.2.
+  v.resize(1);
+  v.push_back({{0.05, -0.05, 0.0}, Eigen::Vector3d(0, std::sin(0.35), std::cos(0.35))});
+  EXPECT_FALSE(equilibrium(v, Eigen::Vector3d(0.025, 0, 0.05), Eigen::Vector3d(0, 0, -1), 0.2, 0.05));
+}
+
+TEST(Quality, HullHelpers) {
+  const auto h = convexHull2d({{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0.5, 0.5}, {1, 0.5}});
+  EXPECT_EQ(h.size(), 4u);
+  EXPECT_NEAR(polygonArea(h), 1.0, 1e-12);
+  EXPECT_TRUE(polygonCentroid(h).isApprox(Eigen::Vector2d(0.5, 0.5)));
+  EXPECT_NEAR(signedBoundaryDistance(h, {0.5, 0.25}), 0.25, 1e-12);
+  EXPECT_NEAR(signedBoundaryDistance(h, {1.5, 0.5}), -0.5, 1e-12);
+  EXPECT_NEAR(boundaryDistanceAlong(h, {0.5, 0.5}, {1, 0}), 0.5, 1e-12);
+  EXPECT_EQ(quality({{0, 0}, {1, 0}}, {0, 0}, 0.1), -1.0);  // degenerate hull
+  EXPECT_NEAR(quality(h, {0.5, 0.5}, 0.0), 1.0, 1e-12);      // centred, lying flat: Q = 1
+}
+
+TEST(ContactPoints, ReduceIsOrderIndependent) {
+  std::vector<SphereContact> raw;
+  for (int i = 0; i < 50; ++i) raw.push_back({v3(0.001 * i, 0, 0), v3(0, 0, 1), 1});
+  raw.push_back({v3(5, 5, 5), v3(0, 0, 1), 0});  // invalid: ignored
+  auto a = reduceContacts(raw, 0.01);
+  std::reverse(raw.begin(), raw.end());
+  auto b = reduceContacts(raw, 0.01);
+  ASSERT_EQ(a.size(), 5u);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i].p_W.isApprox(b[i].p_W, 1e-12));
+}
+
+TEST(SphereModel, SpacingAndGridHeights) {
+  const Mesh plane = scenes::plane(0.1, 0.1);
+  const AreaModel am = buildAreaModel(plane, {0, 0, -1}, 0.005, 0.01, 0.01);
+  // 0.1 m square at 1 cm spacing: about 100 interior spheres plus edges and corners.
+  EXPECT_GT(am.spheres.centres.size(), 90u);
+  EXPECT_LT(am.spheres.centres.size(), 200u);
+  for (const V3& c : am.spheres.centres) EXPECT_NEAR(c.z, 0.0, 1e-12);
+  // Every non-empty cell's height is the plane plus the collision distance.
+  for (size_t k = 0; k < am.grid.max_z.size(); ++k)
+    if (am.grid.start[k + 1] > am.grid.start[k]) EXPECT_NEAR(am.grid.max_z[k], 0.01, 1e-12);
+}

@@ -32,14 +32,17 @@ ValidatorConfig withFriction(double mu) {
 }
 
 TEST(PhysicsValidator, CubeFlatOnTableIsConfirmed) {
-  PhysicsValidator v(cube(), scenes::table(), withFriction(0.2));
+  ValidatorConfig c = withFriction(0.2);
+  c.early_accept_steps = 0;  // the full 2 s
+  PhysicsValidator v(cube(), scenes::table(), c);
   EXPECT_LE(v.convexPieces(), 12);  // at most one per triangle
   EXPECT_GE(v.convexPieces(), 6);
   EXPECT_NEAR(v.mass(), 400.0 * 1e-3, 1e-9);
   const PoseCheck r = v.check(Eigen::Isometry3d::Identity());
   EXPECT_TRUE(r.confirmed) << "moved " << r.moved_m << " m, turned " << r.turned_deg << " deg";
-  EXPECT_LT(r.moved_m, 0.004);
+  EXPECT_LT(r.moved_m, 0.003);  // the 2 mm release gap
   EXPECT_LT(r.turned_deg, 0.5);
+  EXPECT_FALSE(r.early_accepted);
   EXPECT_NEAR(r.sim_time, 2.0, 1e-6);
 }
 
@@ -109,6 +112,38 @@ TEST(PhysicsValidator, CylinderLyingOnItsSideIsConfirmed) {
   PhysicsValidator v(scenes::cylinder(r, h, 32), scenes::table(), withFriction(0.3));
   const PoseCheck c = v.check(pose(R, {0, 0, apothem}));
   EXPECT_TRUE(c.confirmed) << "moved " << c.moved_m << " m, turned " << c.turned_deg << " deg";
+}
+
+// The early-accept shortcut gives the same verdict and nearly the same pose as the full 2 s.
+TEST(PhysicsValidator, EarlyAcceptAgreesWithTheFullRun) {
+  struct Case {
+    Mesh object, area;
+    Eigen::Isometry3d X;
+    double mu;
+  };
+  const double r = 0.04, h = 0.1, tilt = 30.0 * M_PI / 180.0;
+  const std::vector<Case> cases = {
+      {cube(), scenes::table(), Eigen::Isometry3d::Identity(), 0.2},
+      {cube(), scenes::plane(1.0, 1.0, 5.0), pose(rotX(5.0), Eigen::Vector3d::Zero()), 0.2},
+      {cube(), scenes::plane(1.0, 1.0, 20.0), pose(rotX(20.0), Eigen::Vector3d::Zero()), 0.4},
+      {cube(), scenes::plane(1.0, 1.0, 20.0), pose(rotX(20.0), Eigen::Vector3d::Zero()), 0.3},
+      {scenes::cylinder(r, h, 32), scenes::binderStack(), pose(Eigen::Matrix3d::Identity(), {-0.05, 0, 0.22}), 0.3},
+      {scenes::cylinder(r, h, 32), scenes::table(),
+       pose(rotX(30.0), {0, 0, r * std::sin(tilt) + h / 2 * std::cos(tilt)}), 0.3}};
+  int early = 0;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    ValidatorConfig full = withFriction(cases[i].mu), fast = full;
+    full.early_accept_steps = 0;
+    const PoseCheck a = PhysicsValidator(cases[i].object, cases[i].area, full).check(cases[i].X);
+    const PoseCheck b = PhysicsValidator(cases[i].object, cases[i].area, fast).check(cases[i].X);
+    EXPECT_EQ(a.confirmed, b.confirmed) << "case " << i;
+    if (b.early_accepted) {
+      ++early;
+      EXPECT_LT(b.sim_time, full.settle_time);
+      EXPECT_LT((a.X_WO_final.translation() - b.X_WO_final.translation()).norm(), 0.002) << i;
+    }
+  }
+  EXPECT_GE(early, 3);
 }
 
 TEST(PhysicsValidator, FloatingPoseIsRejected) {

@@ -29,8 +29,8 @@ struct PlannerConfig {
   double time_budget_ms = 0.0;               // 0 = no budget
   int max_candidates = 10;                   // after ranking and merging
   int threads = 0;                           // 0 = all hardware threads
-  int max_local_optimisation_steps = 4;      // slides/rotations per leaf (Section VI)
-  double min_tipping_angle_deg = 8.0;        // stable needs at least this tilt to tip over
+  int max_local_optimisation_steps = 8;      // slides/rotations per leaf (Section VI)
+  double min_tipping_angle_deg = 3.0;        // stable needs at least this tilt to tip over
   // Start orientation R_WO of the object (mode keep uses it; the others rotate it minimally).
   Eigen::Quaterniond start_orientation = Eigen::Quaterniond::Identity();
   double min_quality = 0.0;                  // candidates below are dropped

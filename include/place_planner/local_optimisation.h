@@ -16,7 +16,10 @@ struct LocalStep {
 
 // Friction violated on a slope: slide along d_f down the plane P (after lifting by `lift`
 // along P's normal so the contact being left is not hit again). Otherwise rotate into the
-// failure direction about d_A = d_f x d_g through the farthest contact of Omega along d_f.
-LocalStep localOptimisationStep(const Stability& s, double lift);
+// failure direction: about the edge of Omega the centre of mass `com` lies beyond, turning so
+// that it descends (a whole edge, where the paper pivots about the farthest contact of Omega
+// with d_A = d_f x d_g: on curved rims a single pivot needs many small turns); without such an
+// edge, the paper's axis.
+LocalStep localOptimisationStep(const Stability& s, const Eigen::Vector3d& com, double lift);
 
 }  // namespace place_planner

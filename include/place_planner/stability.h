@@ -26,6 +26,10 @@ struct Stability {
   Failure failure = Failure::kTip;
   Eigen::Vector3d d_f = Eigen::Vector3d::Zero();    // failure direction (unit)
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  // farthest contact of Omega along d_f
+  // Tipping: the edge of Omega that the centre of mass lies beyond (or is nearest to), as a
+  // point and unit direction; zero direction when Omega is degenerate.
+  Eigen::Vector3d tip_edge_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tip_edge_dir = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> hull;                // Omega, on P
 };
 

@@ -325,7 +325,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
             rotating.push_back(std::move(n));
           } else if (n.opt < max_opt) {
             const auto tl = Clock::now();
-            const LocalStep step = localOptimisationStep(s, cd);
+            const LocalStep step = localOptimisationStep(s, com, cd);
             st.steps.local_optimisation += msSince(tl);
             if (step.kind == LocalStep::kSlide) {
               ++n.opt;
@@ -357,9 +357,17 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
         std::vector<RotationQuery> q;
         for (const Node& n : rotating) {
           RotationQuery rq{n.X, toV3(n.s_A), toV3(n.d_A)};
+          // Of the tree's two branches (Section V-C) only those that lower the centre of mass
+          // are followed: gravity cannot tip a free object the other way, and the cut keeps
+          // the tree linear in the number of rotations instead of exponential.
+          const Eigen::Vector3d c = toEigen(apply(n.X, om.com));
+          const double dz = n.d_A.cross(c - n.s_A).z();  // d(com.z)/d(angle) for +rotation
+          const double lever = (c - n.s_A).norm();
+          if (!n.local_rotation && dz > 1e-3 * lever) rq.limit_ccw = 0;
+          if (!n.local_rotation && dz < -1e-3 * lever) rq.limit_cw = 0;
           // Directions a contact blocks, or not asked for, are not searched (limit 0).
-          if (blocked(n.contacts, n.s_A, n.d_A, 1, 0.5 * cd)) rq.limit_ccw = 0;
-          if (!n.both_directions || blocked(n.contacts, n.s_A, n.d_A, -1, 0.5 * cd)) rq.limit_cw = 0;
+          if (blocked(n.contacts, n.s_A, n.d_A, 1, 1.5 * cd)) rq.limit_ccw = 0;
+          if (!n.both_directions || blocked(n.contacts, n.s_A, n.d_A, -1, 1.5 * cd)) rq.limit_cw = 0;
           q.push_back(rq);
         }
         std::vector<AnglePair> av, ae;

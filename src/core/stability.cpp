@@ -71,6 +71,37 @@ Eigen::Vector3d tipDirection(const Support& s) {
   return h.normalized();
 }
 
+// The hull edge crossed by the ray from c_Omega through c^_O (or the nearest edge when they
+// coincide), in 3D.
+void tipEdge(const Support& s, Eigen::Vector3d* point, Eigen::Vector3d* dir) {
+  const size_t n = s.hull2.size();
+  if (n < 3) return;
+  Eigen::Vector2d d = s.c_hat_O - s.c_omega;
+  size_t best_i = 0;
+  double best = 1e300;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d a = s.hull2[i], e = s.hull2[(i + 1) % n] - a;
+    double key;
+    if (d.norm() > 1e-9) {
+      const double den = d.x() * e.y() - d.y() * e.x();
+      if (std::abs(den) < 1e-18) continue;
+      const Eigen::Vector2d r = a - s.c_omega;
+      const double t = (r.x() * e.y() - r.y() * e.x()) / den;
+      const double u = (r.x() * d.y() - r.y() * d.x()) / den;
+      if (t < 0 || u < -1e-9 || u > 1 + 1e-9) continue;
+      key = t;
+    } else {
+      key = std::abs((a - s.c_hat_O).x() * e.y() - (a - s.c_hat_O).y() * e.x()) / e.norm();
+    }
+    if (key < best) {
+      best = key;
+      best_i = i;
+    }
+  }
+  *point = s.hull3[best_i];
+  *dir = (s.hull3[(best_i + 1) % n] - s.hull3[best_i]).normalized();
+}
+
 Eigen::Vector3d farthest(const std::vector<ContactPoint>& c, const Eigen::Vector3d& d) {
   Eigen::Vector3d best = c.front().p_W;
   for (const auto& p : c)
@@ -189,6 +220,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     } else {
       r.failure = Failure::kTip;
       r.d_f = tipDirection(s);
+      tipEdge(s, &r.tip_edge_point, &r.tip_edge_dir);
     }
     r.pivot = farthest(contacts, r.d_f);
     return r;
@@ -240,6 +272,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   } else {
     r.failure = Failure::kTip;
     r.d_f = ref.valid ? tipDirection(ref) : Eigen::Vector3d::UnitX();
+    if (ref.valid) tipEdge(ref, &r.tip_edge_point, &r.tip_edge_dir);
   }
   r.pivot = farthest(contacts, r.d_f);
   return r;

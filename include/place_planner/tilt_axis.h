@@ -10,7 +10,7 @@ namespace place_planner {
 enum class ContactLayout {
   kNone,         // no contact
   kSingle,       // all contacts within `tol` of one point
-  kCollinear,    // all contacts within `tol` of one line
+  kCollinear,    // all contacts within `tol` (or a tenth of their length) of one line
   kIndependent,  // at least three contacts not on one line: stop rotating (Section V-C)
 };
 

@@ -314,15 +314,18 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
           };
           if (getenv("PP_DEBUG")) std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d friction %d inside %d tip %.1f deg Q %.3f failure %d com (%.3f %.3f %.3f) zmin %.4f\n", n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable, s.friction_ok, s.com_inside, s.tipping_angle*180/M_PI, s.quality, (int)s.failure, com.x(), com.y(), com.z(), n.contacts.empty()?0.0:n.contacts[0].p_W.z());
           if (n.contacts.empty()) continue;
-          if (s.stable) {
-            leaf(true);
-          } else if ((axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear) &&
-                     n.depth < config.max_rotations) {
+          const bool line = axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear;
+          if (line && n.depth < config.max_rotations) {
+            // One contact or a line of contacts never holds an object: tilt (Section V-C).
             n.s_A = axis.s_A;
             n.d_A = axis.d_A;
             n.both_directions = true;
             n.local_rotation = false;
             rotating.push_back(std::move(n));
+          } else if (line) {
+            leaf(false);
+          } else if (s.stable) {
+            leaf(true);
           } else if (n.opt < max_opt) {
             const auto tl = Clock::now();
             const LocalStep step = localOptimisationStep(s, com, cd);

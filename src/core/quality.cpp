@@ -107,7 +107,7 @@ double quality(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& 
     term1 = off.norm() / std::max(l, 1e-12);
   }
   const double ratio = std::max(0.0, h) / std::sqrt(area);
-  const double s = 0.25 * ratio * ratio;
+  const double s = ratio * ratio / 16.0;
   return 1.0 - term1 - s / (1.0 + s);
 }
 

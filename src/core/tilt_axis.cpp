@@ -20,6 +20,7 @@ TiltAxis tiltAxis(const std::vector<ContactPoint>& contacts, const Eigen::Vector
     spread = std::max(spread, (p.p_W - c).norm());
   }
   a.s_A = c;
+  constexpr double kLineAspect = 0.1;  // half-width / length of a line contact
   // Parallel test: sin of the angle below ~0.6 degrees.
   constexpr double kParallel = 1e-2;
   if (spread <= tol) {
@@ -37,12 +38,16 @@ TiltAxis tiltAxis(const std::vector<ContactPoint>& contacts, const Eigen::Vector
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
   const Eigen::Vector3d dir = es.eigenvectors().col(2).normalized();
-  double off = 0;
+  double off = 0, lo = 0, hi = 0;
   for (const auto& p : contacts) {
     const Eigen::Vector3d r = p.p_W - c;
     off = std::max(off, (r - r.dot(dir) * dir).norm());
+    lo = std::min(lo, r.dot(dir));
+    hi = std::max(hi, r.dot(dir));
   }
-  if (off <= tol) {
+  // A band of contacts much longer than wide is a line contact (a cylinder on its side): its
+  // width comes from the contact tolerance on a curved surface, not from a support.
+  if (off <= std::max(tol, kLineAspect * (hi - lo))) {
     a.layout = ContactLayout::kCollinear;
     a.d_A = dir;
     return a;

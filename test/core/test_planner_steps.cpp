@@ -179,7 +179,7 @@ TEST(Stability, SquareFootprintQualityAndFailure) {
   Stability s = evaluateStability(sq, Eigen::Vector3d(0, 0, 0.05), p);
   EXPECT_TRUE(s.planar);
   EXPECT_TRUE(s.stable);
-  EXPECT_NEAR(s.quality, 1.0 - 1.0 / 17.0, 1e-9);  // s = (0.05/0.1)^2/4 = 1/16
+  EXPECT_NEAR(s.quality, 1.0 - 1.0 / 65.0, 1e-9);  // s = (0.05/0.1)^2/16 = 1/64
   EXPECT_GE(s.quality, 0.9);
   EXPECT_NEAR(s.tipping_angle, M_PI / 4, 1e-9);
   EXPECT_EQ(s.hull.size(), 4u);
@@ -189,9 +189,9 @@ TEST(Stability, SquareFootprintQualityAndFailure) {
   EXPECT_EQ(s.failure, Failure::kTip);
   EXPECT_GT(s.d_f.x(), 0.99);
   EXPECT_NEAR(s.pivot.x(), 0.05, 1e-12);
-  // Half way to the edge: Q = 1 - 0.5 - 1/17.
+  // Half way to the edge: Q = 1 - 0.5 - 1/65.
   s = evaluateStability(sq, Eigen::Vector3d(0.025, 0, 0.05), p);
-  EXPECT_NEAR(s.quality, 0.5 - 1.0 / 17.0, 1e-9);
+  EXPECT_NEAR(s.quality, 0.5 - 1.0 / 65.0, 1e-9);
 }
 
 TEST(Stability, SlopeFrictionAndEquilibrium) {

@@ -10,8 +10,8 @@
 //  - object: a btCompoundShape of small btConvexHullShape pieces, each a group of neighbouring
 //    triangles of similar normal, thickened inwards up to `piece_thickness` (a GImpact mesh
 //    jitters on a triangle mesh; small hulls rest still), margins `margin` (1 mm: 0.5 mm gave
-//    wrong static friction) and inset by the two margins so that the true surfaces touch (a cube
-//    on a table rests at its geometric height, not 2 mm above), friction mu (Bullet multiplies the two coefficients: mu x 1.0);
+//    wrong static friction), each hull shrunk by the two margins so that the true surfaces touch
+//    (a cube on a table rests at its geometric height, not 2 mm above), friction mu (Bullet multiplies the two coefficients: mu x 1.0);
 //  - mass = density x bounding-box volume, centred on the mesh's centre of mass c_O (the same
 //    surface centroid the planner uses), inertia of the solid bounding box about c_O.
 #pragma once

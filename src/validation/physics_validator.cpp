@@ -1,6 +1,7 @@
 // Bullet model of one object/area pair: shapes built once, a fresh world per simulation.
 #include "place_planner/validation/physics_validator.h"
 
+#include <LinearMath/btConvexHullComputer.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
@@ -101,9 +102,9 @@ double rayDepth(const Mesh& m, const Eigen::Vector3d& p, const Eigen::Vector3d& 
 }
 
 // Groups neighbouring triangles (sharing an edge) of similar normal into pieces; each piece
-// becomes one convex hull: its vertices moved inwards (against the piece's area-weighted normal)
-// by 2 margins, plus the same moved a further thickness (piece_thickness, or less where the
-// opposite side of the object is closer). Zero-area triangles are skipped.
+// becomes the point set of a convex slab: its vertices plus the same moved inwards (against the
+// piece's area-weighted normal) by a thickness (piece_thickness, or less where the opposite
+// side of the object is closer). Zero-area triangles are skipped.
 std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const ValidatorConfig& c) {
   const int nt = static_cast<int>(m.triangles.size());
   std::vector<Eigen::Vector3d> normal(nt), centroid(nt);
@@ -157,25 +158,21 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
     for (int t : group) n += area[t] * normal[t];
     n = n.norm() > 1e-12 ? Eigen::Vector3d(n.normalized()) : normal[seed];
-    // Inset by both margins (object's and area's): Bullet keeps the margin-inflated shapes
-    // apart, so the true surfaces then touch where the geometry says.
-    const double inset = 2.0 * c.margin;
     // Thickness: piece_thickness, less where the opposite surface is closer (thin walls, the
-    // marker's 2 cm body): the inflated piece must not poke out on the other side.
+    // marker's 2 cm body) so that the piece does not poke out on the other side.
     double depth = std::numeric_limits<double>::infinity();
     for (int t : group)
       for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d& p = m.vertices[m.triangles[t][k]];
         depth = std::min(depth, rayDepth(m, p - 1e-6 * n, -n, group));
       }
-    const double thickness =
-        std::clamp(depth - inset - 2.0 * c.margin, 0.5 * c.margin, c.piece_thickness);
+    const double thickness = std::clamp(depth, 6.0 * c.margin, c.piece_thickness);
     std::vector<Eigen::Vector3d> pts;
     for (int t : group)
       for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d& p = m.vertices[m.triangles[t][k]];
-        pts.push_back(p - inset * n);
-        pts.push_back(p - (inset + thickness) * n);
+        pts.push_back(p);
+        pts.push_back(p - thickness * n);
       }
     pieces.push_back(std::move(pts));
   }
@@ -266,9 +263,18 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
   // Object: compound of convex pieces, body origin at c_O, axes of O.
   d.object_shape = std::make_unique<btCompoundShape>(true, static_cast<int>(object_O.triangles.size()));
   for (const auto& pts : makeConvexPieces(object_O, config)) {
+    // Shrink every face of the slab by both margins (object's and area's): Bullet keeps the
+    // margin-inflated shapes apart, so the true surfaces then touch where the geometry says
+    // (unshrunk, a cube rested 2 mm above the table). The hull keeps its vertices only.
+    std::vector<double> xyz;
+    for (const auto& p : pts)
+      for (int k = 0; k < 3; ++k) xyz.push_back(p[k] - d.c_O[k]);
+    btConvexHullComputer ch;
+    ch.compute(xyz.data(), 3 * sizeof(double), static_cast<int>(pts.size()),
+               btScalar(2.0 * config.margin), btScalar(0.45));
+    if (ch.vertices.size() < 4) continue;
     auto hull = std::make_unique<btConvexHullShape>();
-    for (const auto& p : pts) hull->addPoint(toBt(Eigen::Vector3d(p - d.c_O)), false);
-    hull->optimizeConvexHull();  // keep the hull's vertices only (support mapping is linear in them)
+    for (int k = 0; k < ch.vertices.size(); ++k) hull->addPoint(ch.vertices[k], false);
     hull->recalcLocalAabb();
     hull->setMargin(btScalar(config.margin));
     btTransform I;

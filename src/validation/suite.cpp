@@ -238,7 +238,7 @@ void writeScenesCsv(const std::vector<SceneResult>& results, const std::string& 
   std::ofstream os(path);
   if (!os) throw std::runtime_error("cannot write " + path);
   os << "scene,variant,object_triangles,area_triangles,floor_points,total_ms,first_stable_ms,"
-        "ms_floor_points,ms_first_contact,ms_contact_points,ms_tilt_vertex,ms_tilt_edge,"
+        "ms_setup,ms_floor_points,ms_first_contact,ms_contact_points,ms_tilt_vertex,ms_tilt_edge,"
         "ms_stability,ms_local_optimisation,candidates,stable,validated,confirmed,precision,"
         "drops,drops_at_rest,drops_fell,drop_ms_mean,drop_ms_median,planner_ms_per_floor_point,"
         "speedup,error\n";
@@ -246,7 +246,7 @@ void writeScenesCsv(const std::vector<SceneResult>& results, const std::string& 
     const StepTimes& st = r.stats.steps;
     os << r.pair.name << ',' << r.variant << ',' << r.object_triangles << ',' << r.area_triangles
        << ',' << r.stats.floor_points_total << ',' << r.stats.total_ms << ','
-       << r.stats.first_stable_ms << ',' << st.floor_points << ',' << st.first_contact << ','
+       << r.stats.first_stable_ms << ',' << st.setup << ',' << st.floor_points << ',' << st.first_contact << ','
        << st.contact_points << ',' << st.tilt_vertex << ',' << st.tilt_edge << ',' << st.stability
        << ',' << st.local_optimisation << ',' << r.candidates << ',' << r.stable << ','
        << r.validated << ',' << r.confirmed << ',' << r.precision() << ',' << r.drops.size() << ','

@@ -103,11 +103,11 @@ TEST(PhysicsValidator, CylinderTiltedOnItsEdgeIsRejected) {
 
 TEST(PhysicsValidator, CylinderLyingOnItsSideIsConfirmed) {
   const double r = 0.04, h = 0.1;
-  // 32-gon: lying on a facet, the facet normal at angle 0 is +x in the cylinder frame; rotate
-  // so it points down (-z): rotate -90 deg about y takes +x to +z, so use +90.
+  // 32-gon lying on a facet: the facet between vertices 0 and 1 has its normal at angle pi/32
+  // about z; turn it to +x, then +90 deg about y takes +x to -z (down).
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix() *
-      Eigen::AngleAxisd(M_PI / 32, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::AngleAxisd(-M_PI / 32, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const double apothem = r * std::cos(M_PI / 32);
   PhysicsValidator v(scenes::cylinder(r, h, 32), scenes::table(), withFriction(0.3));
   const PoseCheck c = v.check(pose(R, {0, 0, apothem}));

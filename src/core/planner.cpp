@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <mutex>
 
@@ -46,7 +47,8 @@ Rigid translated(Rigid X, const V3& d) {
 struct Node {
   Rigid X;
   int root = 0;
-  int depth = 0;  // rotations of the tree (Section V-C)
+  int depth = 0;  // rotations of the tree (Section V-C), not counting small ones
+  int turns = 0;  // all rotations, small ones included
   int opt = 0;    // local optimisation steps (Section VI)
   std::vector<Rigid> path;
   std::vector<V3> pending;  // translations still to do, directions
@@ -84,6 +86,11 @@ double angleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 }
 
 std::once_flag g_backend_log;
+// PP_TRACE=1 in the environment prints every tree node and rotation to stderr.
+const bool kTrace = std::getenv("PP_TRACE") != nullptr;
+constexpr double kSmallTurn = 2.0 * M_PI / 180.0;
+constexpr int kMaxTurnsPerRotation = 4;
+const double kSteepLine = std::sin(30.0 * M_PI / 180.0);
 
 // FNV-1a over the bytes of the area mesh and the model parameters.
 uint64_t fingerprint(const Mesh& area, const Eigen::Vector3d& g, double r, double cd, double cell) {
@@ -312,10 +319,14 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
               best_q = std::max(best_q, s.quality);
             }
           };
-          if (getenv("PP_DEBUG")) std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d friction %d inside %d tip %.1f deg Q %.3f failure %d com (%.3f %.3f %.3f) zmin %.4f\n", n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable, s.friction_ok, s.com_inside, s.tipping_angle*180/M_PI, s.quality, (int)s.failure, com.x(), com.y(), com.z(), n.contacts.empty()?0.0:n.contacts[0].p_W.z());
+          if (kTrace) std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d friction %d inside %d tip %.1f deg Q %.3f failure %d com (%.3f %.3f %.3f) zmin %.4f\n", n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable, s.friction_ok, s.com_inside, s.tipping_angle*180/M_PI, s.quality, (int)s.failure, com.x(), com.y(), com.z(), n.contacts.empty()?0.0:n.contacts[0].p_W.z());
           if (n.contacts.empty()) continue;
-          const bool line = axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear;
-          if (line && n.depth < config.max_rotations) {
+          // A steep line of contacts (a pen leaning from a cup's floor to its rim) can hold the
+          // object by friction; it goes to the stability test like independent contacts. A
+          // single contact or a flat line (a cylinder on its side) never holds.
+          const bool steep = axis.layout == ContactLayout::kCollinear && std::abs(axis.d_A.z()) > kSteepLine;
+          const bool line = !steep && (axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear);
+          if (line && n.depth < config.max_rotations && n.turns < kMaxTurnsPerRotation * config.max_rotations) {
             // One contact or a line of contacts never holds an object: tilt (Section V-C).
             n.s_A = axis.s_A;
             n.d_A = axis.d_A;
@@ -341,7 +352,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
               ++n.opt;
               n.s_A = step.s_A;
               n.d_A = step.d_A;
-              if (getenv("PP_DEBUG")) std::fprintf(stderr, "  local rotate d_f (%.3f %.3f %.3f) pivot (%.3f %.3f %.3f) axis (%.3f %.3f %.3f) n_P (%.3f %.3f %.3f)\n", s.d_f.x(), s.d_f.y(), s.d_f.z(), s.pivot.x(), s.pivot.y(), s.pivot.z(), step.d_A.x(), step.d_A.y(), step.d_A.z(), s.plane_normal.x(), s.plane_normal.y(), s.plane_normal.z());
+              if (kTrace) std::fprintf(stderr, "  local rotate d_f (%.3f %.3f %.3f) pivot (%.3f %.3f %.3f) axis (%.3f %.3f %.3f) n_P (%.3f %.3f %.3f)\n", s.d_f.x(), s.d_f.y(), s.d_f.z(), s.pivot.x(), s.pivot.y(), s.pivot.z(), step.d_A.x(), step.d_A.y(), step.d_A.z(), s.plane_normal.x(), s.plane_normal.y(), s.plane_normal.z());
               n.both_directions = false;
               n.local_rotation = true;
               rotating.push_back(std::move(n));
@@ -390,12 +401,15 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
           for (int sigma : {1, -1}) {
             if (sigma < 0 && !n.both_directions) continue;
             const double a = sigma > 0 ? std::min(av[i].ccw, ae[i].ccw) : std::min(av[i].cw, ae[i].cw);
-            if (getenv("PP_DEBUG")) std::fprintf(stderr, "root %d depth %d opt %d local %d sigma %d contacts %zu angle %.2f deg (v %.2f e %.2f)\n", n.root, n.depth, n.opt, (int)n.local_rotation, sigma, n.contacts.size(), a*180/M_PI, (sigma>0?av[i].ccw:av[i].cw)*180/M_PI, (sigma>0?ae[i].ccw:ae[i].cw)*180/M_PI);
+            if (kTrace) std::fprintf(stderr, "root %d depth %d opt %d local %d sigma %d contacts %zu angle %.2f deg (v %.2f e %.2f)\n", n.root, n.depth, n.opt, (int)n.local_rotation, sigma, n.contacts.size(), a*180/M_PI, (sigma>0?av[i].ccw:av[i].cw)*180/M_PI, (sigma>0?ae[i].ccw:ae[i].cw)*180/M_PI);
             if (a >= kInf) continue;  // blocked, or turns freely: no resting pose that way
             Node c;
             c.X = rotated(n.X, n.s_A, n.d_A, sigma * a);
             c.root = n.root;
-            c.depth = n.depth + (n.local_rotation ? 0 : 1);
+            // Rolling over the facets of a curved surface takes many small turns; only turns of
+            // a few degrees count against max_rotations (all of them against a hard cap).
+            c.depth = n.depth + (n.local_rotation || a < kSmallTurn ? 0 : 1);
+            c.turns = n.turns + 1;
             c.opt = n.opt;
             c.path = n.path;
             c.path.push_back(c.X);

@@ -10,6 +10,8 @@ namespace place_planner {
 namespace {
 
 const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();  // -d_g in G
+// A contact "opposes" the failure direction when its normal is within this angle of -d'_f.
+const double kOpposingAngle = 60.0 * M_PI / 180.0;
 
 // 2D analysis of a support polygon in the plane through `origin` with normal `n` (unit),
 // centre of mass projected along gravity (-z).
@@ -182,6 +184,25 @@ bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3
   return nnls(A, b) < 1e-6;
 }
 
+// Support polygon of `pts` seen along `dir` (a plane through the centre of mass with normal
+// dir), with the centre of mass inside-test; the 2D analysis of analyse() without gravity.
+Support analyse2(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& dir,
+                 const Eigen::Vector3d& com) {
+  Support s;
+  s.n = dir;
+  s.origin = com;
+  s.u = dir.unitOrthogonal();
+  s.w = dir.cross(s.u);
+  std::vector<Eigen::Vector2d> p2;
+  for (const auto& p : pts) p2.emplace_back((p - com).dot(s.u), (p - com).dot(s.w));
+  s.hull2 = convexHull2d(p2);
+  if (s.hull2.size() < 3 || std::abs(polygonArea(s.hull2)) < 1e-10) return s;
+  s.c_hat_O = Eigen::Vector2d::Zero();
+  s.inside = signedBoundaryDistance(s.hull2, s.c_hat_O);
+  s.valid = true;
+  return s;
+}
+
 Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                             const StabilityParams& prm) {
   Stability r;
@@ -196,11 +217,16 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
   Eigen::Vector3d n = es.eigenvectors().col(0).normalized();
   if (n.dot(kUp) < 0) n = -n;
-  double off = 0;
-  for (const auto& p : contacts) off = std::max(off, std::abs((p.p_W - c).dot(n)));
+  double off = 0, spread2 = 0;
+  const Eigen::Vector3d second = es.eigenvectors().col(1).normalized();
+  for (const auto& p : contacts) {
+    off = std::max(off, std::abs((p.p_W - c).dot(n)));
+    spread2 = std::max(spread2, std::abs((p.p_W - c).dot(second)));
+  }
   std::vector<Eigen::Vector3d> pts;
   for (const auto& p : contacts) pts.push_back(p.p_W);
-  if (off <= prm.tol && n.dot(kUp) > 1e-3) {
+  // Planar: on one plane and spanning it (contacts on a line lie on every plane through it).
+  if (off <= prm.tol && spread2 > prm.tol && n.dot(kUp) > 1e-3) {
     r.planar = true;
     r.plane_normal = n;
     const Support s = analyse(pts, c, n, com);
@@ -251,6 +277,31 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     r.com_inside = ref.inside >= 0;
   }
   bool stable = s1.valid && s1.inside >= 0 && s1.tip >= prm.min_tipping_angle && s1.quality >= 0.3;
+  if (!stable && !below.empty()) {
+    // Paper's heuristic, second step: the object would move along d'_f = c_O - c(Omega')
+    // (horizontal); contacts whose normal opposes d'_f catch it. With gravity replaced by
+    // d'_f, the supporting contacts (below and opposing) form Omega''; the centre of mass
+    // must project into it along d'_f (a pen leaning from a cup's floor against its rim).
+    Eigen::Vector3d cb = Eigen::Vector3d::Zero();
+    for (const auto& p : below) cb += p;
+    cb /= static_cast<double>(below.size());
+    Eigen::Vector3d df = com - cb;
+    df.z() = 0;
+    if (df.norm() > 1e-6) {
+      df.normalize();
+      std::vector<Eigen::Vector3d> support = below;
+      int opposing = 0;
+      for (const auto& p : contacts)
+        if (p.n_W.dot(-df) > std::cos(kOpposingAngle)) {
+          support.push_back(p.p_W);
+          ++opposing;
+        }
+      if (opposing > 0) {
+        const Support s2 = analyse2(support, df, com);
+        stable = s2.valid && s2.inside >= 0;
+      }
+    }
+  }
   if (!stable) {
     // Equilibrium: forces within the friction cones balance gravity, also with gravity tilted
     // by half the friction angle in four directions (a margin against sliding and tipping).

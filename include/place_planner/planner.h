@@ -72,6 +72,11 @@ class Planner {
   // Throws std::invalid_argument for a bad config (naming the field).
   PlanResult plan(const Mesh& object, const Mesh& area, const PlannerConfig& config,
                   const ProgressCallback& progress = {}) const;
+
+  // The prepared area (sphere model, BVHs, height grid) of the last few areas is cached across
+  // calls, as a robot places several objects on one area; stats.steps.setup shows the cost.
+  // This drops the cache (benchmarks of cold starts).
+  static void clearAreaCache();
 };
 
 }  // namespace place_planner

@@ -108,10 +108,13 @@ uint64_t fingerprint(const Mesh& area, const Eigen::Vector3d& g, double r, doubl
 
 // The area model (sphere model, BVHs, height grid) is the costly part of a plan and depends
 // only on the area and the radii: the last few are kept, as a node re-plans on the same area.
+std::mutex g_cache_mutex;
+std::vector<std::pair<uint64_t, std::shared_ptr<const AreaModel>>> g_cache;
+
 std::shared_ptr<const AreaModel> cachedAreaModel(const Mesh& area, const Eigen::Vector3d& g,
                                                  double r, double cd, double cell) {
-  static std::mutex mutex;
-  static std::vector<std::pair<uint64_t, std::shared_ptr<const AreaModel>>> cache;
+  std::mutex& mutex = g_cache_mutex;
+  auto& cache = g_cache;
   const uint64_t key = fingerprint(area, g, r, cd, cell);
   {
     std::lock_guard<std::mutex> lock(mutex);
@@ -127,6 +130,11 @@ std::shared_ptr<const AreaModel> cachedAreaModel(const Mesh& area, const Eigen::
 
 
 }  // namespace
+
+void Planner::clearAreaCache() {
+  std::lock_guard<std::mutex> lock(g_cache_mutex);
+  g_cache.clear();
+}
 
 PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConfig& config,
                          const ProgressCallback& progress) const {
@@ -388,10 +396,12 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
         tp = Clock::now();
         backend->vertexSurfaceRotation(q, av);
         st.steps.tilt_vertex += msSince(tp);
-        // Edge/edge only has to beat the vertex/surface angle.
+        // Edge/edge only has to beat the vertex/surface angle. Where no vertex meets a patch
+        // within the 60 degree search, the object turns off the area (an edge crossing alone
+        // would only be a single contact to tilt further about): no edge/edge search.
         for (size_t i = 0; i < q.size(); ++i) {
-          q[i].limit_ccw = std::min(q[i].limit_ccw, av[i].ccw);
-          q[i].limit_cw = std::min(q[i].limit_cw, av[i].cw);
+          q[i].limit_ccw = av[i].ccw >= kInf ? 0.0 : std::min(q[i].limit_ccw, av[i].ccw);
+          q[i].limit_cw = av[i].cw >= kInf ? 0.0 : std::min(q[i].limit_cw, av[i].cw);
         }
         tp = Clock::now();
         backend->edgeEdgeRotation(q, ae);

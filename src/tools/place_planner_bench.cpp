@@ -1,0 +1,126 @@
+// Google Benchmark of the planner at the paper's workload (Section VII-C): about 140 floor
+// points, max 5 rotations, the mug decimated to 200, 500 and 1000 triangles, on books_stack
+// and dish_rack from ../shared/data. Counters: time to the first stable candidate, floor points,
+// tree nodes, stable candidates and time per batched step (ms). "cold" rebuilds the area's
+// model every iteration; "warm" reuses it (a robot placing several objects on one area).
+//
+//   place_planner_bench --data ../shared/data [--benchmark_filter=...]
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "place_planner/floor_points.h"
+#include "place_planner/mesh_io.h"
+#include "place_planner/planner.h"
+#include "place_planner/validation/mesh_variants.h"
+
+using namespace place_planner;
+
+namespace {
+
+std::string g_data = "../shared/data";
+constexpr int kTargetFloorPoints = 140;
+
+const Mesh* mesh(const std::string& key) {
+  static std::map<std::string, std::unique_ptr<Mesh>> cache;
+  auto it = cache.find(key);
+  if (it != cache.end()) return it->second.get();
+  std::unique_ptr<Mesh> m;
+  try {
+    const auto at = key.find('@');
+    if (at == std::string::npos) {
+      m = std::make_unique<Mesh>(loadMesh(g_data + "/" + key));
+    } else {  // "tris@file": the file decimated to about tris triangles
+      const Mesh full = loadMesh(g_data + "/" + key.substr(at + 1));
+      m = std::make_unique<Mesh>(validation::decimateByClustering(full, std::stoi(key.substr(0, at))));
+    }
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+  return (cache[key] = std::move(m)).get();
+}
+
+// Spacing that gives about kTargetFloorPoints rays on the area (the paper's 140).
+double spacingFor(const Mesh& area) {
+  const AreaModel am = buildAreaModel(area, {0, 0, -1}, 0.003, 0.006, 0.006);
+  double lo = 0.005, hi = 0.2;
+  for (int i = 0; i < 30; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    FloorPointParams p;
+    p.d_vis = v3(0, 0, -1);
+    p.spacing = mid;
+    p.min_points = 1;
+    const int n = static_cast<int>(floorPoints(am, p).points.size());
+    (n > kTargetFloorPoints ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+void runPlan(benchmark::State& state, const std::string& area_file, bool cold) {
+  const int tris = static_cast<int>(state.range(0));
+  const Mesh* object = tris >= 1000 ? mesh("objects/mug_ycb025_1k.ply")
+                                    : mesh(std::to_string(tris) + "@objects/mug_ycb025.ply");
+  const Mesh* area = mesh(area_file);
+  if (!object || !area) {
+    state.SkipWithError(("../shared/data not found at " + g_data).c_str());
+    return;
+  }
+  PlannerConfig cfg;
+  cfg.floor_point_spacing = spacingFor(*area);
+  cfg.threads = 2;
+  cfg.max_rotations = 5;
+  PlanResult r;
+  StepTimes sum;
+  double first = 0;
+  for (auto _ : state) {
+    if (cold) Planner::clearAreaCache();
+    r = Planner().plan(*object, *area, cfg);
+    const StepTimes& s = r.stats.steps;
+    sum.setup += s.setup;
+    sum.first_contact += s.first_contact;
+    sum.contact_points += s.contact_points;
+    sum.tilt_vertex += s.tilt_vertex;
+    sum.tilt_edge += s.tilt_edge;
+    sum.stability += s.stability;
+    first += r.stats.first_stable_ms;
+  }
+  const double n = static_cast<double>(state.iterations());
+  int stable = 0;
+  for (const auto& c : r.candidates) stable += c.stable;
+  state.counters["object_tris"] = static_cast<double>(object->triangles.size());
+  state.counters["floor_points"] = r.stats.floor_points_total;
+  state.counters["tree_nodes"] = static_cast<double>(r.stats.tree_nodes);
+  state.counters["stable"] = stable;
+  state.counters["first_stable_ms"] = first / n;
+  state.counters["setup_ms"] = sum.setup / n;
+  state.counters["distance_ms"] = sum.first_contact / n;
+  state.counters["contacts_ms"] = sum.contact_points / n;
+  state.counters["vertex_rot_ms"] = sum.tilt_vertex / n;
+  state.counters["edge_rot_ms"] = sum.tilt_edge / n;
+  state.counters["stability_ms"] = sum.stability / n;
+}
+
+void BM_BooksStackWarm(benchmark::State& s) { runPlan(s, "areas/books_stack.ply", false); }
+void BM_BooksStackCold(benchmark::State& s) { runPlan(s, "areas/books_stack.ply", true); }
+void BM_DishRackWarm(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", false); }
+void BM_DishRackCold(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", true); }
+
+}  // namespace
+
+BENCHMARK(BM_BooksStackWarm)->Arg(200)->Arg(500)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BooksStackCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DishRackWarm)->Arg(200)->Arg(500)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DishRackCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) g_data = argv[++i];
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -179,6 +179,49 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
   return pieces;
 }
 
+// Volume of the convex hull of the points (fan over each hull face, apex at the first vertex).
+double hullVolume(const std::vector<Eigen::Vector3d>& pts) {
+  std::vector<double> xyz;
+  for (const auto& p : pts)
+    for (int k = 0; k < 3; ++k) xyz.push_back(p[k]);
+  btConvexHullComputer ch;
+  ch.compute(xyz.data(), 3 * sizeof(double), static_cast<int>(pts.size()), 0, 0);
+  if (ch.vertices.size() < 4) return 0.0;
+  const btVector3 apex = ch.vertices[0];
+  double vol = 0.0;
+  for (int f = 0; f < ch.faces.size(); ++f) {
+    const btConvexHullComputer::Edge* e0 = &ch.edges[ch.faces[f]];
+    const btVector3 a = ch.vertices[e0->getSourceVertex()];
+    const btConvexHullComputer::Edge* e = e0->getNextEdgeOfFace();
+    while (e->getTargetVertex() != e0->getSourceVertex()) {
+      const btVector3 b = ch.vertices[e->getSourceVertex()];
+      const btVector3 c = ch.vertices[e->getTargetVertex()];
+      vol += std::abs((a - apex).dot((b - apex).cross(c - apex))) / 6.0;
+      e = e->getNextEdgeOfFace();
+    }
+  }
+  return vol;
+}
+
+// Mesh volume / convex hull volume for a closed mesh (every edge in exactly two triangles);
+// 0 for an open mesh.
+double meshConvexity(const Mesh& m) {
+  std::map<std::pair<int, int>, int> edge_count;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      int i = t[k], j = t[(k + 1) % 3];
+      if (i > j) std::swap(i, j);
+      ++edge_count[{i, j}];
+    }
+  for (const auto& [e, n] : edge_count)
+    if (n != 2) return 0.0;
+  double vol = 0.0;  // divergence theorem, outward triangles
+  for (const auto& t : m.triangles)
+    vol += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6.0;
+  const double hull = hullVolume(m.vertices);
+  return hull > 0 ? std::abs(vol) / hull : 0.0;
+}
+
 struct World {
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher{&config};
@@ -206,6 +249,7 @@ struct PhysicsValidator::Impl {
   Eigen::Vector3d up_W = Eigen::Vector3d::UnitZ();  // against gravity
   double area_lowest = 0.0;                         // min over area vertices of up . p
   double build_ms = 0.0;
+  double convexity = 0.0;
 
   // A fresh world with the static area and the object at X_WO at rest.
   struct Sim {
@@ -262,7 +306,14 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
 
   // Object: compound of convex pieces, body origin at c_O, axes of O.
   d.object_shape = std::make_unique<btCompoundShape>(true, static_cast<int>(object_O.triangles.size()));
-  for (const auto& pts : makeConvexPieces(object_O, config)) {
+  // A (nearly) convex closed object is one hull: exact and much cheaper than pieces.
+  std::vector<std::vector<Eigen::Vector3d>> pieces;
+  d.convexity = meshConvexity(object_O);
+  if (d.convexity >= config.convex_volume_ratio)
+    pieces.push_back(object_O.vertices);
+  else
+    pieces = makeConvexPieces(object_O, config);
+  for (const auto& pts : pieces) {
     // Shrink every face of the slab by both margins (object's and area's): Bullet keeps the
     // margin-inflated shapes apart, so the true surfaces then touch where the geometry says
     // (unshrunk, a cube rested 2 mm above the table). The hull keeps its vertices only.
@@ -312,6 +363,7 @@ const ValidatorConfig& PhysicsValidator::config() const { return impl_->cfg; }
 double PhysicsValidator::mass() const { return impl_->mass; }
 int PhysicsValidator::convexPieces() const { return static_cast<int>(impl_->hulls.size()); }
 double PhysicsValidator::shapeBuildMs() const { return impl_->build_ms; }
+double PhysicsValidator::convexity() const { return impl_->convexity; }
 
 PoseCheck PhysicsValidator::check(const Eigen::Isometry3d& X_WO_goal) const {
   const auto t0 = Clock::now();

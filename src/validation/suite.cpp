@@ -51,9 +51,11 @@ double lowestPoint(const Mesh& object, const Eigen::Isometry3d& X_WO, const Eige
   return lo;
 }
 
-// The pre-placement pose above floor point i: the planner's own when a candidate started there;
-// else the best candidate's pre-placement pose moved to the floor point; else the object as given.
-// Raised when it would start inside the area (5 mm clearance above the highest nearby vertex).
+// The drop start above floor point i: the planner's pre-placement pose when a candidate started
+// there, else the best candidate's pre-placement orientation moved over the floor point, else the
+// object as given. Its height: lowest point 1 cm above the highest area vertex near the floor
+// point (drops from the planner's approach height, 10-30 cm, bounced off and tunnelled through
+// thin areas).
 Eigen::Isometry3d dropStart(const PlanResult& plan, int i, const Mesh& object, const Mesh& area,
                             const Eigen::Vector3d& up) {
   const Eigen::Vector3d fp = plan.floor_points_W[i];
@@ -72,10 +74,9 @@ Eigen::Isometry3d dropStart(const PlanResult& plan, int i, const Mesh& object, c
   } else {
     X.translation() = fp - object.properties.center_of_mass;
   }
-  const double need =
-      clearanceAt(area, fp, up, object.properties.bounding_radius) + 0.005;
+  const double clear = clearanceAt(area, fp, up, object.properties.bounding_radius) + 0.01;
   const double low = lowestPoint(object, X, up);
-  if (low < need) X.translation() += (need - low) * up;
+  X.translation() += (clear - low) * up;
   return X;
 }
 

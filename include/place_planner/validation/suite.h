@@ -31,7 +31,7 @@ struct SuiteConfig {
   PlannerConfig planner;        // threads is set to 1 by default (Bullet is single-threaded)
   ValidatorConfig validator;    // friction is overwritten by planner.friction
   int max_validated = 5;        // stable candidates validated per scene (best ranked first)
-  int max_drops = 16;           // floor points dropped per scene (evenly spread); 0 = none
+  int max_drops = 8;            // floor points dropped per scene (evenly spread); 0 = none
   double hole_fraction = 0.0;   // > 0: plan on a copy with this fraction deleted in patches
   std::uint32_t hole_seed = 1;
   SuiteConfig() { planner.threads = 1; }

@@ -13,4 +13,7 @@ namespace place_planner {
 // voxel, so it does not depend on the order of `raw`. Empty input gives an empty result.
 std::vector<ContactPoint> reduceContacts(const std::vector<SphereContact>& raw, double cell);
 
+// The same clustering applied to contact points (coarser summaries for the result).
+std::vector<ContactPoint> reduceContacts(const std::vector<ContactPoint>& contacts, double cell);
+
 }  // namespace place_planner

@@ -35,4 +35,11 @@ std::vector<ContactPoint> reduceContacts(const std::vector<SphereContact>& raw, 
   return out;
 }
 
+std::vector<ContactPoint> reduceContacts(const std::vector<ContactPoint>& contacts, double cell) {
+  std::vector<SphereContact> raw;
+  raw.reserve(contacts.size());
+  for (const auto& c : contacts) raw.push_back(SphereContact{toV3(c.p_W), toV3(c.n_W), 1});
+  return reduceContacts(raw, cell);
+}
+
 }  // namespace place_planner

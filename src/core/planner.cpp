@@ -205,16 +205,29 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     }
     fp.points = kept;
   }
-  // Anytime order: central floor points first (they rarely hang over an edge), so good poses
-  // come early; the set tried is the paper's, only the order changes.
+  // Anytime order: floor points amid a wide flat neighbourhood first (more neighbours at the
+  // same height), then central ones; such points rarely let the object hang over an edge, so
+  // good poses come early. The set tried is the paper's; only the order changes.
   if (!fp.points.empty()) {
     V3 c = v3(0, 0, 0);
     for (const V3& p : fp.points) c = c + p;
     c = (1.0 / fp.points.size()) * c;
-    std::stable_sort(fp.points.begin(), fp.points.end(), [&](const V3& a, const V3& b) {
-      const V3 da = a - c, db = b - c;
-      return da.x * da.x + da.y * da.y < db.x * db.x + db.y * db.y;
-    });
+    std::vector<std::pair<int, double>> key(fp.points.size());
+    for (size_t i = 0; i < fp.points.size(); ++i) {
+      int flat = 0;
+      for (const V3& q : fp.points) {
+        const V3 d = q - fp.points[i];
+        flat += d.x * d.x + d.y * d.y < 2.5 * fp.spacing * fp.spacing && std::abs(d.z) < 0.005;
+      }
+      const V3 dc = fp.points[i] - c;
+      key[i] = {-flat, dc.x * dc.x + dc.y * dc.y};
+    }
+    std::vector<size_t> idx(fp.points.size());
+    for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return key[a] < key[b]; });
+    std::vector<V3> sorted;
+    for (size_t i : idx) sorted.push_back(fp.points[i]);
+    fp.points = sorted;
   }
   for (const V3& p : fp.points) result.floor_points_W.push_back(R_GW.transpose() * toEigen(p));
   st.steps.floor_points = msSince(tp);
@@ -468,7 +481,8 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     if (dup) continue;
     c.quality = l.quality;
     c.stable = l.stable;
-    for (const auto& p : l.contacts) c.contacts.push_back({R_WG * p.p_W, R_WG * p.n_W});
+    // The result summarises the contacts in cells of a third of the object's radius.
+    for (const auto& p : reduceContacts(l.contacts, R_obj / 3.0)) c.contacts.push_back({R_WG * p.p_W, R_WG * p.n_W});
     c.floor_point_W = result.floor_points_W[l.root / orientations.size()];
     for (const Rigid& X : l.path) {
       const Eigen::Isometry3d T = toIsometry(X);

@@ -4,6 +4,7 @@
 #include <random>
 #include <regex>
 
+#include "place_planner/backend.h"
 #include "place_planner/config.h"
 #include "place_planner/cuda_backend.h"
 #include "place_planner/kernels/transform_vertices.h"
@@ -120,4 +121,49 @@ TEST(Config, DefaultsAreValidAndBadFieldsAreNamed) {
   expectField(c, "max_rotations");
   EXPECT_EQ(orientationModeFromString("all_axes"), OrientationMode::kAllAxes);
   EXPECT_THROW(orientationModeFromString("upright"), std::invalid_argument);
+}
+
+// nvblox style: the four CUDA kernels give the CPU backend's answers. Needs a GPU.
+TEST(Backends, CudaKernelsMatchCpu) {
+  std::string why;
+  if (!cuda::available(&why)) GTEST_SKIP() << "no usable GPU: " << why;
+  const Mesh mug = scenes::mug();
+  const ObjectModel om = buildObjectModel(mug, 0.0015);
+  const AreaModel am = buildAreaModel(scenes::binderStack(), {0, 0, -1}, 0.002, 0.0035, 0.0035);
+  const TiltParams tp{0.002, 1e-6};
+  auto cpu = makeCpuBackend(om, am, tp, 2);
+  auto gpu = makeCudaBackend(om, am, tp);
+  std::vector<TranslationQuery> tq;
+  std::vector<RotationQuery> rq;
+  std::vector<Rigid> poses;
+  for (int i = 0; i < 40; ++i) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.1 * i, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.linear() = R;
+    X.translation() = Eigen::Vector3d(-0.1 + 0.005 * i, 0.02, 0.4);
+    tq.push_back({toRigid(X), v3(0, 0, -1), 1.0});
+    X.translation().z() = 0.2;
+    poses.push_back(toRigid(X));
+    rq.push_back({toRigid(X), v3(-0.1 + 0.005 * i, 0.02, 0.17), v3(0, 1, 0)});
+  }
+  std::vector<double> tc, tg;
+  cpu->distance(tq, tc);
+  gpu->distance(tq, tg);
+  std::vector<AnglePair> ac, ag, ec, eg;
+  cpu->vertexSurfaceRotation(rq, ac);
+  gpu->vertexSurfaceRotation(rq, ag);
+  cpu->edgeEdgeRotation(rq, ec);
+  gpu->edgeEdgeRotation(rq, eg);
+  std::vector<std::vector<SphereContact>> cc, cg;
+  cpu->contactPoints(poses, cc);
+  gpu->contactPoints(poses, cg);
+  // Same per-pose code on both: equal up to the GPU's fused multiply-adds.
+  constexpr double kTol = 1e-9;
+  for (size_t i = 0; i < tq.size(); ++i) {
+    EXPECT_NEAR(std::min(tc[i], 10.0), std::min(tg[i], 10.0), kTol);
+    EXPECT_NEAR(std::min(ac[i].ccw, 10.0), std::min(ag[i].ccw, 10.0), kTol);
+    EXPECT_NEAR(std::min(ac[i].cw, 10.0), std::min(ag[i].cw, 10.0), kTol);
+    EXPECT_NEAR(std::min(ec[i].ccw, 10.0), std::min(eg[i].ccw, 10.0), kTol);
+    EXPECT_EQ(cc[i].size(), cg[i].size());
+  }
 }

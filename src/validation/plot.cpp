@@ -15,8 +15,10 @@ namespace {
 
 const cv::Scalar kBlack(0, 0, 0), kGrey(200, 200, 200), kWhite(255, 255, 255);
 // Tableau-like palette (BGR).
-const cv::Scalar kPalette[] = {{180, 119, 31}, {14, 127, 255}, {44, 160, 44}, {40, 39, 214},
-                               {189, 103, 148}, {75, 86, 140}, {194, 119, 227}, {127, 127, 127}};
+const cv::Scalar kPalette[] = {{180, 119, 31}, {14, 127, 255}, {44, 160, 44},  {40, 39, 214},
+                               {189, 103, 148}, {75, 86, 140},  {194, 119, 227}, {127, 127, 127},
+                               {34, 189, 188},  {0, 0, 0}};
+constexpr size_t kColours = sizeof(kPalette) / sizeof(kPalette[0]);
 const int kFont = cv::FONT_HERSHEY_SIMPLEX;
 
 std::string num(double v) {
@@ -75,9 +77,9 @@ Frame axes(const std::string& title, const std::string& y_label, double y0, doub
 
 void legend(Frame& f, const std::vector<Series>& series) {
   int y = f.box.y + 10;
-  const int x = f.box.x + f.box.width + 20;
+  const int x = f.box.x + f.box.width + 30;
   for (size_t i = 0; i < series.size(); ++i) {
-    const cv::Scalar c = kPalette[i % 8];
+    const cv::Scalar c = kPalette[i % kColours];
     cv::rectangle(f.img, {x, y - 8}, {x + 20, y + 4}, c, cv::FILLED);
     cv::putText(f.img, series[i].name, {x + 28, y + 4}, kFont, 0.45, kBlack, 1, cv::LINE_AA);
     y += 22;
@@ -115,7 +117,7 @@ void plotLines(const std::string& path, const std::string& title, const std::str
   cv::putText(f.img, x_label, {f.box.x + f.box.width / 2 - 120, f.box.y + f.box.height + 50}, kFont,
               0.55, kBlack, 1, cv::LINE_AA);
   for (size_t i = 0; i < series.size(); ++i) {
-    const cv::Scalar c = kPalette[i % 8];
+    const cv::Scalar c = kPalette[i % kColours];
     bool have_prev = false;
     cv::Point prev;
     for (size_t k = 0; k < x.size() && k < series[i].y.size(); ++k) {
@@ -161,7 +163,7 @@ void plotBars(const std::string& path, const std::string& title, const std::stri
       if (k >= static_cast<int>(series[s].y.size()) || !std::isfinite(series[s].y[k])) continue;
       const double xl = k + 0.1 + 0.8 * s / ns, xr = k + 0.1 + 0.8 * (s + 1) / ns;
       const double v = std::clamp(series[s].y[k], y_min, y_max);
-      cv::rectangle(a.img, a.at(xl, y_min), a.at(xr, v), kPalette[s % 8], cv::FILLED);
+      cv::rectangle(a.img, a.at(xl, y_min), a.at(xr, v), kPalette[s % kColours], cv::FILLED);
     }
     // Label rotated 90 degrees under the group.
     cv::Mat lab(16, 250, CV_8UC3, kWhite);
@@ -175,8 +177,8 @@ void plotBars(const std::string& path, const std::string& title, const std::stri
   if (reference_line > y_min && reference_line < y_max) {
     const cv::Point p = a.at(0, reference_line);
     cv::line(a.img, {a.box.x, p.y}, {a.box.x + a.box.width, p.y}, kBlack, 1, cv::LINE_AA);
-    cv::putText(a.img, "target " + num(reference_line), {a.box.x + a.box.width + 4, p.y + 4}, kFont,
-                0.4, kBlack, 1, cv::LINE_AA);
+    cv::putText(a.img, "target " + num(reference_line), {a.box.x + 4, p.y - 4}, kFont, 0.4, kBlack,
+                1, cv::LINE_AA);
   }
   cv::rectangle(a.img, a.box, kBlack, 1);
   legend(a, series);

@@ -273,9 +273,9 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
 
   // Roots are processed in groups so good poses appear early (anytime behaviour).
   // The first group is small so the first stable pose comes quickly.
-  const int group = std::max(8, 4 * resolveThreads(config.threads));
+  const int group = std::max(16, 12 * resolveThreads(config.threads));
   bool stop = !report();
-  for (int g0 = 0, gsize = std::max(2, group / 4); g0 < num_roots && !stop; g0 += gsize, gsize = group) {
+  for (int g0 = 0, gsize = std::max(4, group / 6); g0 < num_roots && !stop; g0 += gsize, gsize = group) {
     std::vector<Node> translate, contact, rotating;
     for (int k = g0; k < std::min(num_roots, g0 + gsize); ++k) {
       const int f = k / static_cast<int>(orientations.size());

@@ -17,26 +17,11 @@ target_link_libraries(place_planner_validation
 target_compile_options(place_planner_validation PRIVATE ${PP_WARN})
 
 # ---------------------------------------------------------------- tools
-# They call Planner::plan; built once a core source defines it (the planner lands separately).
-set(PP_VALIDATION_HAVE_PLANNER OFF)
-file(GLOB PP_VALIDATION_CORE_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/core/*.cpp)
-foreach(f ${PP_VALIDATION_CORE_SOURCES})
-  file(STRINGS ${f} pp_hit REGEX "Planner::plan\\(")
-  if(pp_hit)
-    set(PP_VALIDATION_HAVE_PLANNER ON)
-  endif()
+foreach(tool place_planner_validate place_planner_suite)
+  add_executable(${tool} src/tools/${tool}.cpp)
+  target_link_libraries(${tool} place_planner_validation)
+  target_compile_options(${tool} PRIVATE ${PP_WARN})
 endforeach()
-if(PP_VALIDATION_HAVE_PLANNER)
-  foreach(tool place_planner_validate place_planner_suite)
-    if(EXISTS ${PROJECT_SOURCE_DIR}/src/tools/${tool}.cpp)
-      add_executable(${tool} src/tools/${tool}.cpp)
-      target_link_libraries(${tool} place_planner_validation)
-      target_compile_options(${tool} PRIVATE ${PP_WARN})
-    endif()
-  endforeach()
-else()
-  message(STATUS "place_planner: Planner::plan not defined yet, validation tools not built")
-endif()
 
 # ---------------------------------------------------------------- tests (validator + smoke suite)
 if(CATKIN_ENABLE_TESTING)
@@ -48,7 +33,4 @@ if(CATKIN_ENABLE_TESTING)
   target_compile_definitions(validation_tests PRIVATE
     PP_SOURCE_DIR="${PP_VALIDATION_REAL_SOURCE_DIR}"
     PP_SHARED_DATA_DIR="${PP_VALIDATION_REAL_SOURCE_DIR}/../shared/data")
-  if(PP_VALIDATION_HAVE_PLANNER)
-    target_compile_definitions(validation_tests PRIVATE PP_VALIDATION_HAVE_PLANNER=1)
-  endif()
 endif()

@@ -9,8 +9,6 @@
 #include "place_planner/validation/suite.h"
 #include "validation_test_helpers.h"
 
-#ifdef PP_VALIDATION_HAVE_PLANNER
-
 namespace place_planner {
 namespace validation {
 namespace {
@@ -89,11 +87,3 @@ TEST(SuiteSmoke, TenPercentHolesStillConfirmedOnTheFullMesh) {
 }  // namespace
 }  // namespace validation
 }  // namespace place_planner
-
-#else
-
-TEST(SuiteSmoke, NeedsThePlanner) {
-  GTEST_SKIP() << "Planner::plan is not in src/core yet: the suite smoke test is not built";
-}
-
-#endif

@@ -138,9 +138,9 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
 // reach are tested; the search stops once the best angle lies inside the windows done.
 // A tilt beyond 60 degrees turns the object over or off the area; the tree does not follow it
 // (where it lands, other branches and floor points reach directly).
-constexpr int kNumAngleWindows = 4;
+constexpr int kNumAngleWindows = 3;
 PP_HD double angleWindowEnd(int k) {
-  const double deg[kNumAngleWindows] = {4, 12, 30, 60};
+  const double deg[kNumAngleWindows] = {12, 35, 60};
   return deg[k] * 0.017453292519943295;
 }
 PP_HD double angleWindowStart(int k) { return k == 0 ? 0.0 : angleWindowEnd(k - 1); }
@@ -299,6 +299,7 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   V3 sum = v3(0, 0, 0), nsum = v3(0, 0, 0);
   int count = 0;
   double gap = kInf;
+  const double lateral2 = 2.25 * area.mesh.sphere_radius * area.mesh.sphere_radius;
   for (int k = g.start[cell]; k < g.start[cell + 1]; ++k) {
     const int i = g.items[k];
     const V3 a = area.mesh.sphere_centres[i];
@@ -309,8 +310,12 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
     nsum = nsum + na;
     ++count;
     // Separation along the area's normal: zero for touching surfaces, whatever the lateral
-    // offset of the two sphere lattices.
-    gap = minv(gap, fabs(dot(s_G - a, na)));
+    // offset of the two sphere lattices. Only where the object sphere lies over this sphere's
+    // share of its patch (lateral offset within 1.5 r): a sphere on the side of a peg says
+    // nothing about an object hovering above the peg's top.
+    const V3 d = s_G - a;
+    const double along = dot(d, na);
+    if (norm2(d - along * na) <= lateral2) gap = minv(gap, fabs(along));
   }
   // Near misses (a gap up to the collision distance) are not contacts: the tree keeps
   // rotating until real contacts hold the object (the paper counts every colliding sphere).

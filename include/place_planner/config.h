@@ -30,6 +30,7 @@ struct PlannerConfig {
   int max_candidates = 10;                   // after ranking and merging
   int threads = 0;                           // 0 = all hardware threads
   int max_local_optimisation_steps = 8;      // slides/rotations per leaf (Section VI)
+  double min_support_width = 0.0;            // m, narrower support polygons do not hold (0 = off)
   double min_tipping_angle_deg = 3.0;        // stable needs at least this tilt to tip over
   // Start orientation R_WO of the object (mode keep uses it; the others rotate it minimally).
   Eigen::Quaterniond start_orientation = Eigen::Quaterniond::Identity();

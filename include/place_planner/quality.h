@@ -13,6 +13,8 @@ double polygonArea(const std::vector<Eigen::Vector2d>& hull);
 Eigen::Vector2d polygonCentroid(const std::vector<Eigen::Vector2d>& hull);  // c_Omega
 // Signed distance of p from the hull's boundary: > 0 inside, < 0 outside.
 double signedBoundaryDistance(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& p);
+// Smallest width of a convex polygon (rotating calipers over its edges); 0 when degenerate.
+double polygonWidth(const std::vector<Eigen::Vector2d>& hull);
 // l_Omega: distance from `from` (inside) to the boundary along unit `dir`.
 double boundaryDistanceAlong(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& from,
                              const Eigen::Vector2d& dir);

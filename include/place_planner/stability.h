@@ -11,6 +11,7 @@ struct StabilityParams {
   double friction = 0.2;          // mu
   double tol = 0.003;             // m, contacts within tol of a plane are coplanar
   double min_tipping_angle = 0.2; // rad: a pose that tips over with less tilt is not stable
+  double min_support_width = 0.0; // m: narrower support polygons (a wall top, a rim) do not hold
 };
 
 enum class Failure { kNone, kSlide, kTip };
@@ -35,7 +36,8 @@ struct Stability {
 
 // Planar case: 2D convex hull Omega of the contacts on P, the centre of mass projected along
 // gravity inside Omega, the angle between P's normal and -d_g below atan(mu), and (added for
-// robustness) a tipping angle of at least min_tipping_angle. Failure direction d_f =
+// robustness) a tipping angle of at least min_tipping_angle and a support polygon at least
+// min_support_width wide (checked in Bullet: objects balanced on 1 cm walls fall). Failure direction d_f =
 // c^_O - c^_Omega (tipping) or down the slope (sliding).
 // Non-planar case: the paper's heuristic (contacts whose normal lies in the friction cone about
 // -d_g form Omega' and are tested like the planar case), then an equilibrium test: non-negative

@@ -40,24 +40,10 @@ class CpuBackend : public Backend {
     });
   }
   void vertexSurfaceRotation(const std::vector<RotationQuery>& q, std::vector<AnglePair>& a) override {
-    a.assign(q.size(), AnglePair{});
-    parallelFor(2 * q.size(), threads_, [&](size_t k) {
-      const size_t i = k / 2;
-      const int sigma = k % 2 ? -1 : 1;
-      const double th = vertexSurfaceAngle(obj_, area_, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp_,
-                                           sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
-      (sigma > 0 ? a[i].ccw : a[i].cw) = th;
-    });
+    rotation(q, a, [](auto&&... args) { return vertexSurfaceAngle(args...); });
   }
   void edgeEdgeRotation(const std::vector<RotationQuery>& q, std::vector<AnglePair>& a) override {
-    a.assign(q.size(), AnglePair{});
-    parallelFor(2 * q.size(), threads_, [&](size_t k) {
-      const size_t i = k / 2;
-      const int sigma = k % 2 ? -1 : 1;
-      const double th = edgeEdgeAngle(obj_, area_, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp_,
-                                           sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
-      (sigma > 0 ? a[i].ccw : a[i].cw) = th;
-    });
+    rotation(q, a, [](auto&&... args) { return edgeEdgeAngle(args...); });
   }
   void contactPoints(const std::vector<Rigid>& X,
                      std::vector<std::vector<SphereContact>>& c) override {
@@ -75,6 +61,19 @@ class CpuBackend : public Backend {
   }
 
  private:
+  // One work item per pose and direction (sigma = +1: ccw, -1: cw).
+  template <typename Kernel>
+  void rotation(const std::vector<RotationQuery>& q, std::vector<AnglePair>& a, Kernel kernel) {
+    a.assign(q.size(), AnglePair{});
+    parallelFor(2 * q.size(), threads_, [&](size_t k) {
+      const size_t i = k / 2;
+      const int sigma = k % 2 ? -1 : 1;
+      const double th = kernel(obj_, area_, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp_,
+                               sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
+      (sigma > 0 ? a[i].ccw : a[i].cw) = th;
+    });
+  }
+
   ObjectView obj_;
   AreaView area_;
   TiltParams tp_;

@@ -48,6 +48,8 @@ void validate(const PlannerConfig& c) {
   require(c.threads >= 0 && c.threads <= 256, "threads", c.threads, "0 .. 256, 0 = all");
   require(c.max_local_optimisation_steps >= 0 && c.max_local_optimisation_steps <= 50,
           "max_local_optimisation_steps", c.max_local_optimisation_steps, "0 .. 50");
+  require(std::isfinite(c.min_support_width) && c.min_support_width >= 0, "min_support_width",
+          c.min_support_width, ">= 0 m");
   require(std::isfinite(c.min_tipping_angle_deg) && c.min_tipping_angle_deg >= 0 &&
               c.min_tipping_angle_deg < 90,
           "min_tipping_angle_deg", c.min_tipping_angle_deg, "0 .. 90");

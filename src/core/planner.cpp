@@ -247,7 +247,11 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
 
   const int num_roots = static_cast<int>(fp.points.size() * orientations.size());
   st.floor_points_total = static_cast<int>(fp.points.size());
-  const StabilityParams sp{config.friction, 1.5 * cd, config.min_tipping_angle_deg * M_PI / 180.0};
+  // Support at least min_support_width wide, or a quarter of the object's middle extent.
+  Eigen::Vector3d ext = object.properties.bounds_max - object.properties.bounds_min;
+  std::sort(ext.data(), ext.data() + 3);
+  const StabilityParams sp{config.friction, 1.5 * cd, config.min_tipping_angle_deg * M_PI / 180.0,
+                           std::min(config.min_support_width, 0.25 * ext[1])};
   const int max_opt = config.max_local_optimisation_steps;
   std::vector<Leaf> leaves;
   double best_q = 0;

@@ -80,6 +80,18 @@ double signedBoundaryDistance(const std::vector<Eigen::Vector2d>& h, const Eigen
   return out ? -outside : inside;
 }
 
+double polygonWidth(const std::vector<Eigen::Vector2d>& h) {
+  if (h.size() < 3) return 0.0;
+  double width = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < h.size(); ++i) {
+    const Eigen::Vector2d a = h[i], e = (h[(i + 1) % h.size()] - a).normalized();
+    double far = 0;
+    for (const auto& p : h) far = std::max(far, std::abs(e.x() * (p - a).y() - e.y() * (p - a).x()));
+    width = std::min(width, far);
+  }
+  return width;
+}
+
 double boundaryDistanceAlong(const std::vector<Eigen::Vector2d>& h, const Eigen::Vector2d& from,
                              const Eigen::Vector2d& dir) {
   double best = std::numeric_limits<double>::infinity();

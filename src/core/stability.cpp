@@ -24,9 +24,10 @@ struct Support {
   Eigen::Vector3d u, w, origin, n;
 };
 
-Support analyse(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& origin,
-                const Eigen::Vector3d& n, const Eigen::Vector3d& com) {
-  Support s;
+// The 2D hull of pts in the plane through `origin` with normal n (basis u, w); false when it is
+// degenerate (fewer than 3 points off one line).
+bool projectHull(Support& s, const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& origin,
+                 const Eigen::Vector3d& n) {
   s.origin = origin;
   s.n = n;
   s.u = n.unitOrthogonal();
@@ -34,7 +35,13 @@ Support analyse(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& 
   std::vector<Eigen::Vector2d> p2;
   for (const auto& p : pts) p2.emplace_back((p - origin).dot(s.u), (p - origin).dot(s.w));
   s.hull2 = convexHull2d(p2);
-  if (s.hull2.size() < 3 || std::abs(polygonArea(s.hull2)) < 1e-10) return s;
+  return s.hull2.size() >= 3 && std::abs(polygonArea(s.hull2)) >= 1e-10;
+}
+
+Support analyse(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& origin,
+                const Eigen::Vector3d& n, const Eigen::Vector3d& com) {
+  Support s;
+  if (!projectHull(s, pts, origin, n)) return s;
   // c^_O: the centre of mass projected along gravity onto P.
   const double den = -kUp.dot(n);
   if (std::abs(den) < 1e-9) return s;
@@ -189,14 +196,7 @@ bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3
 Support analyse2(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& dir,
                  const Eigen::Vector3d& com) {
   Support s;
-  s.n = dir;
-  s.origin = com;
-  s.u = dir.unitOrthogonal();
-  s.w = dir.cross(s.u);
-  std::vector<Eigen::Vector2d> p2;
-  for (const auto& p : pts) p2.emplace_back((p - com).dot(s.u), (p - com).dot(s.w));
-  s.hull2 = convexHull2d(p2);
-  if (s.hull2.size() < 3 || std::abs(polygonArea(s.hull2)) < 1e-10) return s;
+  if (!projectHull(s, pts, com, dir)) return s;
   s.c_hat_O = Eigen::Vector2d::Zero();
   s.inside = signedBoundaryDistance(s.hull2, s.c_hat_O);
   s.valid = true;
@@ -236,7 +236,8 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     r.tipping_angle = s.tip;
     r.com_inside = s.inside >= 0;
     r.friction_ok = std::acos(std::clamp(n.dot(kUp), -1.0, 1.0)) < cone;  // angle(P, -d_g) < atan(mu)
-    r.stable = r.friction_ok && r.com_inside && s.tip >= prm.min_tipping_angle && s.quality >= 0.3;
+    r.stable = r.friction_ok && r.com_inside && s.tip >= prm.min_tipping_angle && s.quality >= 0.3 &&
+               polygonWidth(s.hull2) >= prm.min_support_width;
     if (r.stable) {
       r.failure = Failure::kNone;
     } else if (!r.friction_ok) {
@@ -276,7 +277,8 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     r.quality = ref.quality;
     r.com_inside = ref.inside >= 0;
   }
-  bool stable = s1.valid && s1.inside >= 0 && s1.tip >= prm.min_tipping_angle && s1.quality >= 0.3;
+  bool stable = s1.valid && s1.inside >= 0 && s1.tip >= prm.min_tipping_angle && s1.quality >= 0.3 &&
+                polygonWidth(s1.hull2) >= prm.min_support_width;
   if (!stable && !below.empty()) {
     // Paper's heuristic, second step: the object would move along d'_f = c_O - c(Omega')
     // (horizontal); contacts whose normal opposes d'_f catch it. With gravity replaced by

@@ -107,6 +107,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("max_candidates", &p.max_candidates);
   r.read("threads", &p.threads);
   r.read("max_local_optimisation_steps", &p.max_local_optimisation_steps);
+  r.read("min_support_width", &p.min_support_width);
   r.read("min_tipping_angle_deg", &p.min_tipping_angle_deg);
   // start_orientation is not a parameter: each goal's object_pose gives it.
   r.read("min_quality", &p.min_quality);

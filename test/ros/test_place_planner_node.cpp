@@ -520,7 +520,7 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
   for (const char* name :
        {"gravity", "approach", "friction", "floor_point_spacing", "min_floor_points", "lowest_n",
         "max_rotations", "sphere_radius", "grid_cell_size", "orientation", "time_budget_ms",
-        "max_candidates", "threads", "max_local_optimisation_steps", "min_tipping_angle_deg",
+        "max_candidates", "threads", "max_local_optimisation_steps", "min_support_width", "min_tipping_angle_deg",
         "min_quality", "merge_distance", "merge_angle_deg", "backend", "region_min", "region_max",
         "planning_frame", "tf_timeout", "feedback_period", "marker_candidates",
         "marker_text_count"}) {
@@ -542,6 +542,7 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
   EXPECT_EQ(y.max_candidates, d.max_candidates);
   EXPECT_EQ(y.threads, d.threads);
   EXPECT_EQ(y.max_local_optimisation_steps, d.max_local_optimisation_steps);
+  EXPECT_EQ(y.min_support_width, d.min_support_width);
   EXPECT_EQ(y.min_tipping_angle_deg, d.min_tipping_angle_deg);
   EXPECT_EQ(y.min_quality, d.min_quality);
   EXPECT_EQ(y.merge_distance, d.merge_distance);

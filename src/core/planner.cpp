@@ -191,12 +191,9 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   fpp.spacing = config.floor_point_spacing;
   fpp.min_points = config.min_floor_points;
   fpp.lowest_n = config.lowest_n;
-  if (config.hasRegion()) {
-    // The region is a box in W; test hits against it in W by mapping G back.
-    fpp.has_region = false;
-  }
   FloorPoints fp = floorPoints(am, fpp);
   if (config.hasRegion()) {
+    // The region is a box in W: hits are mapped back from G and tested there.
     std::vector<V3> kept;
     for (const V3& p : fp.points) {
       const Eigen::Vector3d pw = R_GW.transpose() * toEigen(p);

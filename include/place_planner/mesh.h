@@ -61,6 +61,10 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
 // watertight), principal axes of the surface's second moment, bounds and bounding radius.
 MeshProperties computeProperties(const Mesh& mesh);
 
+// For each triangle, the triangles that share an edge with it (several across a non-manifold
+// edge, none across a hole's border).
+std::vector<std::vector<int>> triangleNeighbours(const Mesh& mesh);
+
 // Returns a copy with every vertex mapped by T (rotation R, translation t); properties recomputed.
 Mesh transformed(const Mesh& mesh, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
 

@@ -233,6 +233,23 @@ MeshProperties computeProperties(const Mesh& mesh) {
   return p;
 }
 
+std::vector<std::vector<int>> triangleNeighbours(const Mesh& mesh) {
+  const int nt = static_cast<int>(mesh.triangles.size());
+  std::map<std::pair<int, int>, std::vector<int>> edge_tris;
+  for (int t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      int i = mesh.triangles[t][k], j = mesh.triangles[t][(k + 1) % 3];
+      if (i > j) std::swap(i, j);
+      edge_tris[{i, j}].push_back(t);
+    }
+  std::vector<std::vector<int>> nbr(nt);
+  for (const auto& kv : edge_tris)
+    for (int a : kv.second)
+      for (int b : kv.second)
+        if (a != b) nbr[a].push_back(b);
+  return nbr;
+}
+
 Mesh transformed(const Mesh& mesh, const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
   Mesh out = mesh;
   for (auto& v : out.vertices) v = R * v + t;

@@ -105,18 +105,7 @@ Mesh punchHoles(const Mesh& mesh, double fraction, std::uint32_t seed, double pa
   const int nt = static_cast<int>(mesh.triangles.size());
   const int to_remove = static_cast<int>(std::round(fraction * nt));
   const int patch = std::max(1, static_cast<int>(std::round(patch_fraction * nt)));
-  std::map<std::pair<int, int>, std::vector<int>> edge_tris;
-  for (int t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) {
-      int i = mesh.triangles[t][k], j = mesh.triangles[t][(k + 1) % 3];
-      if (i > j) std::swap(i, j);
-      edge_tris[{i, j}].push_back(t);
-    }
-  std::vector<std::vector<int>> nbr(nt);
-  for (const auto& [e, ts] : edge_tris)
-    for (int a : ts)
-      for (int b : ts)
-        if (a != b) nbr[a].push_back(b);
+  const std::vector<std::vector<int>> nbr = triangleNeighbours(mesh);
   std::mt19937 rng(seed);
   std::vector<char> removed(nt, 0);
   int n_removed = 0;

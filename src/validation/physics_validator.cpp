@@ -119,19 +119,7 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
     normal[t] = area[t] > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
     centroid[t] = (a + b + d) / 3.0;
   }
-  // Edge -> triangles.
-  std::map<std::pair<int, int>, std::vector<int>> edge_tris;
-  for (int t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) {
-      int i = m.triangles[t][k], j = m.triangles[t][(k + 1) % 3];
-      if (i > j) std::swap(i, j);
-      edge_tris[{i, j}].push_back(t);
-    }
-  std::vector<std::vector<int>> nbr(nt);
-  for (const auto& [e, ts] : edge_tris)
-    for (int a : ts)
-      for (int b : ts)
-        if (a != b) nbr[a].push_back(b);
+  const std::vector<std::vector<int>> nbr = triangleNeighbours(m);
 
   const double cos_max = std::cos(c.piece_max_normal_deg * M_PI / 180.0);
   std::vector<char> used(nt, 0);

@@ -38,27 +38,10 @@ inline BvhView view(const Bvh& b) {
 
 constexpr int kBvhStack = 64;
 
-// Calls f(primitive) for every primitive whose leaf box overlaps `query`.
-template <typename F>
-PP_HD void bvhQuery(const BvhView& bvh, const Aabb& query, F&& f) {
-  if (bvh.num_nodes == 0) return;
-  int stack[kBvhStack];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const BvhNode& n = bvh.nodes[stack[--top]];
-    if (!aabbOverlap(n.box, query)) continue;
-    if (n.left < 0) {
-      for (int i = n.first; i < n.first + n.count; ++i) f(bvh.order[i]);
-    } else if (top + 2 <= kBvhStack) {
-      stack[top++] = n.left;
-      stack[top++] = n.right;
-    }
-  }
-}
-
-// True when some leaf box overlaps `query` (early exit).
-PP_HD bool bvhAnyOverlap(const BvhView& bvh, const Aabb& query) {
+// Visits the leaves whose boxes overlap `query`, depth first; leaf(node) returns true to stop
+// the walk. Returns true when a leaf stopped it.
+template <typename Leaf>
+PP_HD bool bvhVisitLeaves(const BvhView& bvh, const Aabb& query, Leaf&& leaf) {
   if (bvh.num_nodes == 0) return false;
   int stack[kBvhStack];
   int top = 0;
@@ -66,13 +49,28 @@ PP_HD bool bvhAnyOverlap(const BvhView& bvh, const Aabb& query) {
   while (top > 0) {
     const BvhNode& n = bvh.nodes[stack[--top]];
     if (!aabbOverlap(n.box, query)) continue;
-    if (n.left < 0) return true;
-    if (top + 2 <= kBvhStack) {
+    if (n.left < 0) {
+      if (leaf(n)) return true;
+    } else if (top + 2 <= kBvhStack) {
       stack[top++] = n.left;
       stack[top++] = n.right;
     }
   }
   return false;
+}
+
+// Calls f(primitive) for every primitive whose leaf box overlaps `query`.
+template <typename F>
+PP_HD void bvhQuery(const BvhView& bvh, const Aabb& query, F&& f) {
+  bvhVisitLeaves(bvh, query, [&](const BvhNode& n) {
+    for (int i = n.first; i < n.first + n.count; ++i) f(bvh.order[i]);
+    return false;
+  });
+}
+
+// True when some leaf box overlaps `query` (early exit).
+PP_HD bool bvhAnyOverlap(const BvhView& bvh, const Aabb& query) {
+  return bvhVisitLeaves(bvh, query, [](const BvhNode&) { return true; });
 }
 
 // Ray slab test: does o + t d, t in [0, tmax], meet the box?

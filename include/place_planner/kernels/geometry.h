@@ -290,11 +290,14 @@ PP_HD AngleWindow angleWindow(double a0, double a1) {
                      1.0 / maxv(cos(0.5 * fabs(a1 - a0)), 1e-3)};
 }
 PP_HD Aabb arcBoxW(V3 p, V3 s_A, V3 d_A, const AngleWindow& w) {
+  // p = c + u rotates to c + cos(a) u + sin(a) (d x u): the circle's centre c and radial u once.
+  const V3 r = p - s_A;
+  const V3 c = s_A + dot(r, d_A) * d_A;
+  const V3 u = p - c, t = cross(d_A, r);
   Aabb b = aabbEmpty();
-  aabbAdd(b, rotateAboutCS(p, s_A, d_A, w.c0, w.s0));
-  aabbAdd(b, rotateAboutCS(p, s_A, d_A, w.c1, w.s1));
-  const V3 c0 = s_A + dot(p - s_A, d_A) * d_A;
-  aabbAdd(b, c0 + w.inv_cos_half * (rotateAboutCS(p, s_A, d_A, w.cm, w.sm) - c0));
+  aabbAdd(b, c + w.c0 * u + w.s0 * t);
+  aabbAdd(b, c + w.c1 * u + w.s1 * t);
+  aabbAdd(b, c + (w.inv_cos_half * w.cm) * u + (w.inv_cos_half * w.sm) * t);
   return b;
 }
 

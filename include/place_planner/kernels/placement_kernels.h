@@ -47,17 +47,23 @@ constexpr int kPairStack = 2 * kBvhStack;
 template <typename BoxA, typename Prep, typename Leaf>
 PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& prep, Leaf&& leaf) {
   if (A.num_nodes == 0 || B.num_nodes == 0) return;
-  int sa[kPairStack], sb[kPairStack];
+  // Each entry carries A's mapped box, so a node of A is mapped once per split, not once per
+  // node of B it meets. Pairs are pushed only when their boxes overlap.
+  struct Pair {
+    int a, b;
+    Aabb box;
+  };
+  Pair stack[kPairStack];
   int top = 0;
-  sa[top] = 0;
-  sb[top++] = 0;
+  {
+    const Aabb root = boxA(A.nodes[0]);
+    if (!aabbOverlap(root, B.nodes[0].box)) return;
+    stack[top++] = Pair{0, 0, root};
+  }
   while (top > 0) {
-    --top;
-    const int ia = sa[top], ib = sb[top];
-    const BvhNode& na = A.nodes[ia];
-    const BvhNode& nb = B.nodes[ib];
-    const Aabb ba = boxA(na);
-    if (!aabbOverlap(ba, nb.box)) continue;
+    const Pair p = stack[--top];
+    const BvhNode& na = A.nodes[p.a];
+    const BvhNode& nb = B.nodes[p.b];
     const bool la = na.left < 0, lb = nb.left < 0;
     if (la && lb) {
       for (int i = na.first; i < na.first + na.count; ++i) {
@@ -67,16 +73,14 @@ PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& 
       continue;
     }
     // Both trees are at most kBvhStack / 2 deep, so this stack cannot overflow.
-    if (!la && (lb || boxVolume(ba) >= boxVolume(nb.box))) {
-      sa[top] = na.left;
-      sb[top++] = ib;
-      sa[top] = na.right;
-      sb[top++] = ib;
+    if (!la && (lb || boxVolume(p.box) >= boxVolume(nb.box))) {
+      for (const int c : {na.right, na.left}) {
+        const Aabb cb = boxA(A.nodes[c]);
+        if (aabbOverlap(cb, nb.box)) stack[top++] = Pair{c, p.b, cb};
+      }
     } else {
-      sa[top] = ia;
-      sb[top++] = nb.left;
-      sa[top] = ia;
-      sb[top++] = nb.right;
+      for (const int c : {nb.right, nb.left})
+        if (aabbOverlap(p.box, B.nodes[c].box)) stack[top++] = Pair{p.a, c, p.box};
     }
   }
 }
@@ -138,9 +142,9 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
 // reach are tested; the search stops once the best angle lies inside the windows done.
 // A tilt beyond 60 degrees turns the object over or off the area; the tree does not follow it
 // (where it lands, other branches and floor points reach directly).
-constexpr int kNumAngleWindows = 3;
+constexpr int kNumAngleWindows = 2;
 PP_HD double angleWindowEnd(int k) {
-  const double deg[kNumAngleWindows] = {12, 35, 60};
+  const double deg[kNumAngleWindows] = {15, 60};
   return deg[k] * 0.017453292519943295;
 }
 PP_HD double angleWindowStart(int k) { return k == 0 ? 0.0 : angleWindowEnd(k - 1); }
@@ -194,8 +198,9 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
     best = th;
   };
   for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
-    const double a0 = sigma * angleWindowStart(k), a1 = sigma * angleWindowEnd(k);
-    const AngleWindow win = angleWindow(a0, a1), win_area = angleWindow(-a0, -a1);
+    // The window ends at the best angle so far: arcs past it cannot give a smaller one.
+    const double a0 = sigma * angleWindowStart(k);
+    const AngleWindow win = angleWindow(a0, sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         om.vertex_bvh, am.triangle_bvh,
         [&](const BvhNode& n) { return arcNodeBox(transformBox(X_GO, n.box), s_A, d_A, win); },
@@ -214,6 +219,8 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
           const int m = vertexTriangleAngles(v, s_A, d_A, A, B, C, tp.tol, out);
           for (int j = 0; j < m; ++j) accept(out[j], sigma, v, am.triangle_normals[t], A, s_A, d_A);
         });
+    if (best <= angleWindowStart(k)) break;
+    const AngleWindow win_area = angleWindow(-a0, -sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         am.vertex_bvh, om.triangle_bvh,
         [&](const BvhNode& n) { return arcNodeBox(transformBoxInv(X_GO, n.box), s_O, d_O, win_area); },
@@ -247,8 +254,8 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
   const AxisFrame frame = axisFrame(s_A, d_A);
   const double max_angle = angleWindowEnd(kNumAngleWindows - 1);
   for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
-    const double a0 = sigma * angleWindowStart(k), a1 = sigma * angleWindowEnd(k);
-    const AngleWindow win = angleWindow(a0, a1);
+    const AngleWindow win =
+        angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         om.edge_bvh, am.edge_bvh,
         [&](const BvhNode& n) { return arcNodeBox(transformBox(X_GO, n.box), s_A, d_A, win); },
@@ -331,19 +338,35 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   return out;
 }
 
-// Calls f(sphere index) for the object spheres whose BVH leaf, posed, comes within the
-// collision distance of an area triangle box, in increasing index order within each leaf.
+// Can a sphere centre inside box b (frame G) collide with an area sphere? Only when b reaches
+// below the maximum height (plus collision distance) of a grid cell under it. Boxes over more
+// than 64 cells are not tested: their children are.
+PP_HD bool gridMayCollide(const GridView& g, const Aabb& b) {
+  const double fx0 = floor((b.lo.x - g.x0) / g.cell), fx1 = floor((b.hi.x - g.x0) / g.cell);
+  const double fy0 = floor((b.lo.y - g.y0) / g.cell), fy1 = floor((b.hi.y - g.y0) / g.cell);
+  // Off the grid: no area sphere there (tested in doubles, before any cast to int).
+  if (fx1 < 0 || fy1 < 0 || fx0 > g.nx - 1 || fy0 > g.ny - 1) return false;
+  const int ix0 = maxv(0.0, fx0), ix1 = minv(g.nx - 1.0, fx1);
+  const int iy0 = maxv(0.0, fy0), iy1 = minv(g.ny - 1.0, fy1);
+  if ((ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 64) return true;
+  for (int iy = iy0; iy <= iy1; ++iy)
+    for (int ix = ix0; ix <= ix1; ++ix)
+      if (b.lo.z <= g.max_z[iy * g.nx + ix]) return true;
+  return false;
+}
+
+// Calls f(sphere index) for the object spheres whose BVH leaf, posed, reaches below the height
+// grid (gridMayCollide), in increasing index order within each leaf.
 template <typename F>
 PP_HD void forEachSphereNearArea(const ObjectView& obj, const AreaView& area, const Rigid& X_GO, F&& f) {
   const BvhView& b = obj.mesh.sphere_bvh;
   if (b.num_nodes == 0) return;
-  const double cd = area.grid.collision_distance;
   int stack[kBvhStack];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const BvhNode& n = b.nodes[stack[--top]];
-    if (!bvhAnyOverlap(area.mesh.triangle_bvh, aabbInflate(transformBox(X_GO, n.box), cd))) continue;
+    if (!gridMayCollide(area.grid, transformBox(X_GO, n.box))) continue;
     if (n.left >= 0) {
       // Right pushed first so the left subtree (lower indices after sorting) comes first.
       stack[top++] = n.right;

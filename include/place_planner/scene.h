@@ -58,7 +58,9 @@ struct AreaModel : MeshModel {  // frame G
 // borders can meet as edge against edge. flat_deg bounds the dihedral angle called flat.
 std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg = 2.0);
 
-MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius);
+// sphere_bvh: also a BVH over the sphere centres (the object's; the area uses its grid).
+MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius,
+                         bool sphere_bvh = true);
 ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius);
 AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
                          double collision_distance, double grid_cell);

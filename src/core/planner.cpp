@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <future>
 #include <memory>
 #include <mutex>
 
@@ -159,8 +160,10 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   const double cell = config.grid_cell_size > 0 ? config.grid_cell_size : cd;
   st.sphere_radius = r;
   auto tp = Clock::now();
-  const ObjectModel om = buildObjectModel(object, r);
+  // The object's model is built while the area's is built or fetched from the cache.
+  auto object_model = std::async(std::launch::async, [&] { return buildObjectModel(object, r); });
   const std::shared_ptr<const AreaModel> area_model = cachedAreaModel(area, d_g_W, r_area, cd, cell);
+  const ObjectModel om = object_model.get();
   const AreaModel& am = *area_model;
   const Eigen::Matrix3d R_GW = am.R_GW;
   st.steps.setup = msSince(tp);

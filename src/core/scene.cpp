@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <map>
 
 namespace place_planner {
@@ -53,7 +54,8 @@ std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg) 
   return out;
 }
 
-MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius) {
+MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius,
+                         bool sphere_bvh) {
   MeshModel m;
   m.vertices.reserve(mesh.vertices.size());
   m.bounds = aabbEmpty();
@@ -62,6 +64,17 @@ MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphe
     aabbAdd(m.bounds, m.vertices.back());
   }
   m.triangles = mesh.triangles;
+  // The sphere model is independent of the BVHs: built on a second thread (same result).
+  auto spheres = std::async(std::launch::async, [&] {
+    SphereModel sm = sampleSpheres(m.vertices, m.triangles, mesh.edges, sphere_radius);
+    if (sphere_bvh) {
+      std::vector<Aabb> sphere_boxes;
+      sphere_boxes.reserve(sm.centres.size());
+      for (const V3& c : sm.centres) sphere_boxes.push_back(Aabb{c, c});
+      sm.bvh = buildBvh(sphere_boxes, 8);
+    }
+    return sm;
+  });
   m.edges = featureEdges(mesh);
   std::vector<Aabb> tri_boxes, edge_boxes, vert_boxes;
   tri_boxes.reserve(m.triangles.size());
@@ -82,11 +95,7 @@ MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphe
   m.triangle_bvh = buildBvh(tri_boxes);
   m.edge_bvh = buildBvh(edge_boxes);
   m.vertex_bvh = buildBvh(vert_boxes);
-  m.spheres = sampleSpheres(m.vertices, m.triangles, mesh.edges, sphere_radius);
-  std::vector<Aabb> sphere_boxes;
-  sphere_boxes.reserve(m.spheres.centres.size());
-  for (const V3& c : m.spheres.centres) sphere_boxes.push_back(Aabb{c, c});
-  m.spheres.bvh = buildBvh(sphere_boxes, 8);
+  m.spheres = spheres.get();
   return m;
 }
 
@@ -103,7 +112,8 @@ AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, d
                          double collision_distance, double grid_cell) {
   AreaModel a;
   a.R_GW = gravityFrame(gravity_W);
-  static_cast<MeshModel&>(a) = buildMeshModel(area_W, a.R_GW, sphere_radius);
+  // The area's spheres are reached through the height grid, not a BVH.
+  static_cast<MeshModel&>(a) = buildMeshModel(area_W, a.R_GW, sphere_radius, false);
   a.grid = buildHeightGrid(a.spheres, a.bounds, collision_distance, grid_cell);
   return a;
 }

@@ -56,6 +56,8 @@ struct AreaModel : MeshModel {  // frame G
 // segment first touches a plane at an end point (or all along, when parallel), so contacts on
 // a flat region are found by the vertex/face tests; only creases, silhouettes and hole
 // borders can meet as edge against edge. flat_deg bounds the dihedral angle called flat.
+// On a closed, consistently wound mesh (a solid) valley edges are dropped too: a crossing
+// contact needs both edges to be ridges (see scene.cpp); open sheets keep both kinds.
 std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg = 2.0);
 
 // sphere_bvh: also a BVH over the sphere centres (the object's; the area uses its grid).

@@ -29,13 +29,38 @@ Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W) {
 }
 
 std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg) {
-  std::map<std::pair<int, int>, std::vector<int>> adjacent;
+  // Each undirected edge with the triangles on it, and whether the first traverses it a -> b.
+  struct EdgeUse {
+    int tris[2] = {-1, -1};
+    int count = 0;
+    int forward = 0;  // triangles traversing it from the lower index to the higher
+  };
+  std::map<std::pair<int, int>, EdgeUse> uses;
   for (size_t t = 0; t < mesh.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       int a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      const bool fwd = a < b;
       if (a > b) std::swap(a, b);
-      adjacent[{a, b}].push_back(static_cast<int>(t));
+      EdgeUse& u = uses[{a, b}];
+      if (u.count < 2) u.tris[u.count] = static_cast<int>(t);
+      ++u.count;
+      u.forward += fwd;
     }
+  // Which side is solid: on a consistently wound, (nearly) closed surface the winding's normals
+  // point out where the signed volume is positive and in where it is negative. Open sheets and
+  // scans (more than 2 % border edges) have no inside: every side may be touched.
+  int border = 0;
+  bool consistent = true;
+  for (const auto& e : uses) {
+    border += e.second.count == 1;
+    if (e.second.count == 2 && e.second.forward != 1) consistent = false;
+  }
+  double volume = 0;
+  const Eigen::Vector3d o = mesh.properties.center_of_mass;
+  for (const auto& t : mesh.triangles)
+    volume += (mesh.vertices[t[0]] - o).dot((mesh.vertices[t[1]] - o).cross(mesh.vertices[t[2]] - o));
+  const int outward = consistent && border <= 0.02 * uses.size() ? (volume > 0) - (volume < 0) : 0;
+
   const double cos_flat = std::cos(flat_deg * M_PI / 180.0);
   auto normal = [&](int t) {
     const auto& tri = mesh.triangles[t];
@@ -45,10 +70,21 @@ std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg) 
   };
   std::vector<std::array<int, 2>> out;
   for (const auto& e : mesh.edges) {
-    const auto it = adjacent.find({e[0], e[1]});
-    if (it != adjacent.end() && it->second.size() == 2 &&
-        std::abs(normal(it->second[0]).dot(normal(it->second[1]))) >= cos_flat)
-      continue;  // flat: the first contact there is a vertex's (see scene.h)
+    const auto it = uses.find({e[0], e[1]});
+    if (it != uses.end() && it->second.count == 2) {
+      const int t1 = it->second.tris[0], t2 = it->second.tris[1];
+      const Eigen::Vector3d n1 = normal(t1);
+      if (std::abs(n1.dot(normal(t2))) >= cos_flat) continue;  // flat: the first contact there is a vertex's
+      // Concave (valley) edge of a solid: the free space around it is a wedge narrower than a
+      // half-space, which another edge can only touch along the valley, never across it; such
+      // contacts start at an end point (a vertex/patch test). Only ridges meet edge against edge.
+      if (outward != 0) {
+        int c = 0;  // the vertex of t2 off the edge
+        for (int k = 0; k < 3; ++k)
+          if (mesh.triangles[t2][k] != e[0] && mesh.triangles[t2][k] != e[1]) c = mesh.triangles[t2][k];
+        if (outward * n1.dot(mesh.vertices[c] - mesh.vertices[e[0]]) > 0) continue;
+      }
+    }
     out.push_back(e);
   }
   return out;

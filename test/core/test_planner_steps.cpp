@@ -1,4 +1,6 @@
 // Each step of the planner on hand-checkable cases.
+#include <algorithm>
+
 #include "place_planner/backend.h"
 #include "place_planner/contact_points.h"
 #include "place_planner/floor_points.h"
@@ -257,4 +259,39 @@ TEST(SphereModel, SpacingAndGridHeights) {
   // Every non-empty cell's height is the plane plus the collision distance.
   for (size_t k = 0; k < am.grid.max_z.size(); ++k)
     if (am.grid.start[k + 1] > am.grid.start[k]) EXPECT_NEAR(am.grid.max_z[k], 0.01, 1e-12);
+}
+
+// Edge/edge candidates (scene.h): on a solid, a valley edge is dropped (only ridges can touch
+// across); on an open sheet it is kept; the winding's sign does not matter.
+TEST(FeatureEdges, RidgesOnlyOnSolids) {
+  // L-shaped prism: the cross-section has one reflex corner at (1, 1), whose vertical edge is
+  // the only valley.
+  const std::vector<Eigen::Vector2d> l = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  std::vector<Eigen::Vector3d> v;
+  for (double z : {0.0, 1.0})
+    for (const auto& p : l) v.emplace_back(p.x(), p.y(), z);
+  std::vector<std::vector<int>> faces = {{5, 4, 3, 2, 1, 0}, {6, 7, 8, 9, 10, 11}};
+  for (int i = 0; i < 6; ++i) faces.push_back({i, (i + 1) % 6, 6 + (i + 1) % 6, 6 + i});
+  auto reflexEdgeKept = [](const Mesh& m) {
+    for (const auto& e : featureEdges(m))
+      if ((e[0] == 3 && e[1] == 9) || (e[0] == 9 && e[1] == 3)) return true;
+    return false;
+  };
+  const Mesh solid = buildMesh(v, faces, "l_prism");
+  // 6 top + 6 bottom + 6 vertical edges; the fan diagonals of the caps are flat.
+  EXPECT_EQ(featureEdges(solid).size(), 17u);
+  EXPECT_FALSE(reflexEdgeKept(solid));
+
+  auto flipped = faces;
+  for (auto& f : flipped) std::reverse(f.begin(), f.end());
+  const Mesh inside_out = buildMesh(v, flipped, "l_prism_flipped");
+  EXPECT_EQ(featureEdges(inside_out).size(), 17u);
+  EXPECT_FALSE(reflexEdgeKept(inside_out));
+
+  // Without its top cap the prism is an open sheet: both sides can be touched.
+  auto open_faces = faces;
+  open_faces.erase(open_faces.begin() + 1);
+  const Mesh open = buildMesh(v, open_faces, "l_prism_open");
+  EXPECT_EQ(featureEdges(open).size(), 18u);
+  EXPECT_TRUE(reflexEdgeKept(open));
 }

@@ -65,15 +65,33 @@ PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& 
     const BvhNode& na = A.nodes[p.a];
     const BvhNode& nb = B.nodes[p.b];
     const bool la = na.left < 0, lb = nb.left < 0;
-    if (la && lb) {
-      for (int i = na.first; i < na.first + na.count; ++i) {
-        const auto data = prep(A.order[i]);
-        for (int j = nb.first; j < nb.first + nb.count; ++j) leaf(data, A.order[i], B.order[j]);
+    if (la) {
+      // A leaf of A: its primitives are prepared once and meet every leaf of B's subtree
+      // under nb that overlaps the leaf's box (not once per leaf pair).
+      using Data = decltype(prep(0));
+      constexpr int kChunk = 8;
+      for (int i0 = na.first; i0 < na.first + na.count; i0 += kChunk) {
+        const int n = minv(kChunk, na.first + na.count - i0);
+        Data data[kChunk];
+        for (int k = 0; k < n; ++k) data[k] = prep(A.order[i0 + k]);
+        int sub[kBvhStack];
+        int st = 0;
+        sub[st++] = p.b;
+        while (st > 0) {
+          const BvhNode& m = B.nodes[sub[--st]];
+          if (m.left >= 0) {
+            if (aabbOverlap(p.box, B.nodes[m.right].box)) sub[st++] = m.right;
+            if (aabbOverlap(p.box, B.nodes[m.left].box)) sub[st++] = m.left;
+            continue;
+          }
+          for (int j = m.first; j < m.first + m.count; ++j)
+            for (int k = 0; k < n; ++k) leaf(data[k], A.order[i0 + k], B.order[j]);
+        }
       }
       continue;
     }
     // Both trees are at most kBvhStack / 2 deep, so this stack cannot overflow.
-    if (!la && (lb || boxVolume(p.box) >= boxVolume(nb.box))) {
+    if (lb || boxVolume(p.box) >= boxVolume(nb.box)) {
       for (const int c : {na.right, na.left}) {
         const Aabb cb = boxA(A.nodes[c]);
         if (aabbOverlap(cb, nb.box)) stack[top++] = Pair{c, p.b, cb};

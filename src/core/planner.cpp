@@ -330,13 +330,23 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
         st.steps.contact_points += msSince(tp);
         tp = Clock::now();
         st.tree_nodes += static_cast<long>(contact.size());
-        for (size_t i = 0; i < contact.size(); ++i) {
+        // Contacts, stability (VI) and tilt axis (V-C.1) of every node are independent: computed
+        // on the pool; the tree decisions below stay serial, in node order.
+        std::vector<Stability> stab(contact.size());
+        std::vector<TiltAxis> axes(contact.size());
+        parallelFor(contact.size(), config.threads, [&](size_t i) {
           Node& n = contact[i];
           n.contacts = reduceContacts(raw[i], cd);
           const Eigen::Vector3d com = toEigen(apply(n.X, om.com));
-          const Stability s = evaluateStability(n.contacts, com, sp);
+          stab[i] = evaluateStability(n.contacts, com, sp);
           const Eigen::Vector3d k1 = toEigen(rotate(n.X, toV3(om.principal_axes.col(0))));
-          const TiltAxis axis = tiltAxis(n.contacts, com, k1, toEigen(d_g), 1.5 * cd, n.root + 7919u * n.depth);
+          axes[i] = tiltAxis(n.contacts, com, k1, toEigen(d_g), 1.5 * cd, n.root + 7919u * n.depth);
+        });
+        for (size_t i = 0; i < contact.size(); ++i) {
+          Node& n = contact[i];
+          const Eigen::Vector3d com = toEigen(apply(n.X, om.com));
+          const Stability& s = stab[i];
+          const TiltAxis& axis = axes[i];
           auto leaf = [&](bool stable) {
             leaves.push_back(Leaf{n.X, n.root, stable, s.quality, n.contacts, n.path});
             if (stable) {

@@ -23,7 +23,7 @@ struct Bvh {
 
 // Builds over the primitive boxes: median split along the longest axis of the centroids,
 // leaves of at most `leaf_size` primitives.
-Bvh buildBvh(const std::vector<Aabb>& boxes, int leaf_size = 4);
+Bvh buildBvh(const std::vector<Aabb>& boxes, int leaf_size = 1);
 
 // Flat view for traversal (host or device pointers).
 struct BvhView {

@@ -5,6 +5,7 @@
 #pragma once
 #include <Eigen/Geometry>
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "place_planner/bvh.h"
@@ -60,9 +61,11 @@ struct AreaModel : MeshModel {  // frame G
 // contact needs both edges to be ridges (see scene.cpp); open sheets keep both kinds.
 std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg = 2.0);
 
-// sphere_bvh: also a BVH over the sphere centres (the object's; the area uses its grid).
+// index_spheres(spheres, bounds) builds the index of the sphere model (the object's BVH, the
+// area's height grid); it runs on the thread that samples the spheres, beside the BVH builds.
+using SphereIndexer = std::function<void(SphereModel&, const Aabb&)>;
 MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius,
-                         bool sphere_bvh = true);
+                         const SphereIndexer& index_spheres = {});
 ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius);
 AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
                          double collision_distance, double grid_cell);

@@ -91,7 +91,7 @@ std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg) 
 }
 
 MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius,
-                         bool sphere_bvh) {
+                         const SphereIndexer& index_spheres) {
   MeshModel m;
   m.vertices.reserve(mesh.vertices.size());
   m.bounds = aabbEmpty();
@@ -100,15 +100,11 @@ MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphe
     aabbAdd(m.bounds, m.vertices.back());
   }
   m.triangles = mesh.triangles;
-  // The sphere model is independent of the BVHs: built on a second thread (same result).
+  // The sphere model and its index are independent of the BVHs: built on a second thread
+  // (same result).
   auto spheres = std::async(std::launch::async, [&] {
     SphereModel sm = sampleSpheres(m.vertices, m.triangles, mesh.edges, sphere_radius);
-    if (sphere_bvh) {
-      std::vector<Aabb> sphere_boxes;
-      sphere_boxes.reserve(sm.centres.size());
-      for (const V3& c : sm.centres) sphere_boxes.push_back(Aabb{c, c});
-      sm.bvh = buildBvh(sphere_boxes, 8);
-    }
+    if (index_spheres) index_spheres(sm, m.bounds);
     return sm;
   });
   m.edges = featureEdges(mesh);
@@ -137,7 +133,14 @@ MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphe
 
 ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius) {
   ObjectModel o;
-  static_cast<MeshModel&>(o) = buildMeshModel(object_O, Eigen::Matrix3d::Identity(), sphere_radius);
+  // The object's spheres are reached through a BVH posed with the object.
+  static_cast<MeshModel&>(o) = buildMeshModel(
+      object_O, Eigen::Matrix3d::Identity(), sphere_radius, [](SphereModel& sm, const Aabb&) {
+        std::vector<Aabb> boxes;
+        boxes.reserve(sm.centres.size());
+        for (const V3& c : sm.centres) boxes.push_back(Aabb{c, c});
+        sm.bvh = buildBvh(boxes, 8);
+      });
   o.com = toV3(object_O.properties.center_of_mass);
   o.bounding_radius = object_O.properties.bounding_radius;
   o.principal_axes = object_O.properties.principal_axes;
@@ -148,9 +151,13 @@ AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, d
                          double collision_distance, double grid_cell) {
   AreaModel a;
   a.R_GW = gravityFrame(gravity_W);
-  // The area's spheres are reached through the height grid, not a BVH.
-  static_cast<MeshModel&>(a) = buildMeshModel(area_W, a.R_GW, sphere_radius, false);
-  a.grid = buildHeightGrid(a.spheres, a.bounds, collision_distance, grid_cell);
+  // The area's spheres are reached through the height grid (V-B), not a BVH.
+  HeightGrid grid;
+  static_cast<MeshModel&>(a) = buildMeshModel(
+      area_W, a.R_GW, sphere_radius, [&](SphereModel& sm, const Aabb& bounds) {
+        grid = buildHeightGrid(sm, bounds, collision_distance, grid_cell);
+      });
+  a.grid = std::move(grid);
   return a;
 }
 

@@ -1,6 +1,7 @@
 // Surface sphere models and the 2D height grid (Section V-B).
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <limits>
 
 #include "place_planner/scene.h"
@@ -82,30 +83,44 @@ HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, 
   const size_t ncell = static_cast<size_t>(g.nx) * g.ny;
   g.max_z.assign(ncell, -std::numeric_limits<double>::infinity());
   std::vector<int> count(ncell, 0);
-  auto forCells = [&](const V3& c, auto&& f) {
-    // Cells meeting the virtual sphere's x/y disc (radius cd): the covering square of cells.
+  // Cells meeting the virtual sphere's x/y disc (radius cd), restricted to the rows [r0, r1).
+  auto forCells = [&](const V3& c, int r0, int r1, auto&& f) {
+    const int iy0 = std::max(r0, static_cast<int>(std::floor((c.y - cd - g.y0) / cell)));
+    const int iy1 = std::min(r1 - 1, static_cast<int>(std::floor((c.y + cd - g.y0) / cell)));
+    if (iy0 > iy1) return;
     const int ix0 = std::max(0, static_cast<int>(std::floor((c.x - cd - g.x0) / cell)));
     const int ix1 = std::min(g.nx - 1, static_cast<int>(std::floor((c.x + cd - g.x0) / cell)));
-    const int iy0 = std::max(0, static_cast<int>(std::floor((c.y - cd - g.y0) / cell)));
-    const int iy1 = std::min(g.ny - 1, static_cast<int>(std::floor((c.y + cd - g.y0) / cell)));
-    for (int iy = iy0; iy <= iy1; ++iy)
+    for (int iy = iy0; iy <= iy1; ++iy) {
+      // Distance from the centre to the cell rectangle, in x/y.
+      const double dy = std::max({0.0, g.y0 + iy * cell - c.y, c.y - (g.y0 + (iy + 1) * cell)});
       for (int ix = ix0; ix <= ix1; ++ix) {
-        // Distance from the centre to the cell rectangle, in x/y.
         const double dx = std::max({0.0, g.x0 + ix * cell - c.x, c.x - (g.x0 + (ix + 1) * cell)});
-        const double dy = std::max({0.0, g.y0 + iy * cell - c.y, c.y - (g.y0 + (iy + 1) * cell)});
         if (dx * dx + dy * dy <= cd * cd) f(static_cast<size_t>(iy) * g.nx + ix);
       }
+    }
   };
-  for (const V3& c : s.centres) forCells(c, [&](size_t k) { ++count[k]; });
+  // Two bands of rows on two threads; each visits the spheres in index order, so every cell
+  // lists its spheres in the same order as a single pass would.
+  const int mid = g.ny / 2;
+  auto bands = [&](auto&& pass) {
+    auto lower = std::async(std::launch::async, [&] { pass(0, mid); });
+    pass(mid, g.ny);
+    lower.get();
+  };
+  bands([&](int r0, int r1) {
+    for (const V3& c : s.centres) forCells(c, r0, r1, [&](size_t k) { ++count[k]; });
+  });
   g.start.assign(ncell + 1, 0);
   for (size_t k = 0; k < ncell; ++k) g.start[k + 1] = g.start[k] + count[k];
   g.items.resize(g.start[ncell]);
   std::vector<int> fill(g.start.begin(), g.start.end() - 1);
-  for (size_t i = 0; i < s.centres.size(); ++i)
-    forCells(s.centres[i], [&](size_t k) {
-      g.items[fill[k]++] = static_cast<int>(i);
-      g.max_z[k] = std::max(g.max_z[k], s.centres[i].z + cd);  // "max z plus collision distance"
-    });
+  bands([&](int r0, int r1) {
+    for (size_t i = 0; i < s.centres.size(); ++i)
+      forCells(s.centres[i], r0, r1, [&](size_t k) {
+        g.items[fill[k]++] = static_cast<int>(i);
+        g.max_z[k] = std::max(g.max_z[k], s.centres[i].z + cd);  // "max z plus collision distance"
+      });
+  });
   return g;
 }
 

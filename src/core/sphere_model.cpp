@@ -14,6 +14,13 @@ SphereModel sampleSpheres(const std::vector<V3>& vertices,
   SphereModel m;
   m.radius = radius;
   const double step = 2.0 * radius;  // "the distance between two sphere centres is 2r"
+  // Room for every sphere up front (lattice, centroids, edges, vertices): no regrowth.
+  double estimate = static_cast<double>(triangles.size() + vertices.size());
+  for (const auto& t : triangles)
+    estimate += 0.5 * norm(cross(vertices[t[1]] - vertices[t[0]], vertices[t[2]] - vertices[t[0]])) / (step * step);
+  for (const auto& e : edges) estimate += norm(vertices[e[1]] - vertices[e[0]]) / step;
+  m.centres.reserve(static_cast<size_t>(1.1 * estimate));
+  m.normals.reserve(static_cast<size_t>(1.1 * estimate));
   std::vector<V3> vnormal(vertices.size(), v3(0, 0, 0));
   for (const auto& t : triangles) {
     const V3 a = vertices[t[0]], b = vertices[t[1]], c = vertices[t[2]];

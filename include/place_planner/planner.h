@@ -52,6 +52,9 @@ struct PlanResult {
   PlanStats stats;
   bool cancelled = false;
   bool timed_out = false;
+  // Doubts about the input that did not stop the plan, one sentence each (e.g. an area with
+  // almost nothing facing against gravity: a scan in its camera frame?).
+  std::vector<std::string> warnings;
 };
 
 struct Progress {

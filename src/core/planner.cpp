@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 
+#include "place_planner/area_up.h"
 #include "place_planner/backend.h"
 #include "place_planner/contact_points.h"
 #include "place_planner/cuda_backend.h"
@@ -89,6 +90,8 @@ double angleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 std::once_flag g_backend_log;
 // PP_TRACE=1 in the environment prints every tree node and rotation to stderr.
 const bool kTrace = std::getenv("PP_TRACE") != nullptr;
+// Below this share of surface facing against gravity (within 20 degrees), the plan warns.
+constexpr double kMinUpFacingShare = 0.05;
 constexpr double kSmallTurn = 2.0 * M_PI / 180.0;
 constexpr int kMaxTurnsPerRotation = 4;
 const double kSteepLine = std::sin(30.0 * M_PI / 180.0);
@@ -150,6 +153,16 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   const Eigen::Vector3d d_g_W = config.gravity.normalized();
   const Eigen::Vector3d d_vis_W =
       config.approach.norm() > 1e-9 ? Eigen::Vector3d(config.approach.normalized()) : d_g_W;
+  // With gravity wrong for the area (a scan in its camera frame) nothing is flat; say so.
+  if (upFacingShare(area, -d_g_W) < kMinUpFacingShare) {
+    const UpEstimate e = estimateUp(area, -d_g_W);
+    char msg[320];
+    std::snprintf(msg, sizeof msg,
+                  "placement area: under %.0f %% of its surface faces against gravity; its largest "
+                  "flat region (%.0f %%) faces (%.3f, %.3f, %.3f): is gravity right?",
+                  100 * kMinUpFacingShare, 100 * e.share, e.up.x(), e.up.y(), e.up.z());
+    result.warnings.push_back(msg);
+  }
   const double R_obj = object.properties.bounding_radius;
   // Sphere radius: about 1% of the object's size, within 0.75 .. 4 mm (Section V-B).
   const double r = config.sphere_radius > 0 ? config.sphere_radius

@@ -258,6 +258,7 @@ void PlacePlannerNode::execute(const PlacePlanGoalConstPtr& goal) {
     server_->setAborted(result, result.error_message);
     return;
   }
+  for (const auto& w : plan.warnings) ROS_WARN("place_planner: %s", w.c_str());
 
   const ros::Time stamp = ros::Time::now();
   result.candidates.resize(plan.candidates.size());

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "place_planner/area_up.h"
 #include "place_planner/mesh_io.h"
 #include "place_planner/planner.h"
 #include "place_planner/scenes.h"
@@ -17,11 +18,13 @@ using namespace place_planner;
 namespace {
 
 const char* kUsage =
-    "usage: place_planner_cli --object O.ply --area P.ply [--gravity x,y,z] [--approach x,y,z]\n"
+    "usage: place_planner_cli --object O.ply --area P.ply [--gravity x,y,z|auto] [--approach x,y,z]\n"
     "       [--friction F] [--spacing M] [--max-rotations N] [--orientation MODE]\n"
     "       [--budget-ms T] [--max-candidates K] [--threads N] [--json OUT]\n"
     "  O and P are .ply/.obj/.stl files or builtin:NAME (table, dish_rack, open_box,\n"
-    "  binder_stack, mug, plate, pen, cube). MODE: principal_axis | keep | all_axes.\n";
+    "  binder_stack, mug, plate, pen, cube). MODE: principal_axis | keep | all_axes.\n"
+    "  --gravity auto: against the normal of the area's largest flat region (a scan in its\n"
+    "  camera frame).\n";
 
 Eigen::Vector3d parseVec(const std::string& flag, const std::string& s) {
   Eigen::Vector3d v;
@@ -78,7 +81,8 @@ int main(int argc, char** argv) {
     if (!args.count("--object") || !args.count("--area"))
       throw std::invalid_argument("--object and --area are required (see --help)");
     PlannerConfig c;
-    if (args.count("--gravity")) c.gravity = parseVec("--gravity", args["--gravity"]);
+    const bool auto_gravity = args.count("--gravity") && args["--gravity"] == "auto";
+    if (args.count("--gravity") && !auto_gravity) c.gravity = parseVec("--gravity", args["--gravity"]);
     if (args.count("--approach")) c.approach = parseVec("--approach", args["--approach"]);
     if (args.count("--friction")) c.friction = parseNum("--friction", args["--friction"]);
     if (args.count("--spacing")) c.floor_point_spacing = parseNum("--spacing", args["--spacing"]);
@@ -96,7 +100,15 @@ int main(int argc, char** argv) {
     validate(c);
     const Mesh object = load(args["--object"]);
     const Mesh area = load(args["--area"]);
+    if (auto_gravity) {
+      // Against the normal of the area's largest flat region (area_up.h).
+      const UpEstimate e = estimateUp(area, -c.gravity);
+      c.gravity = -e.up;
+      std::printf("gravity (auto): (%.3f, %.3f, %.3f), the largest flat region being %.0f %% of the area\n",
+                  c.gravity.x(), c.gravity.y(), c.gravity.z(), 100 * e.share);
+    }
     const PlanResult r = Planner().plan(object, area, c);
+    for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     const auto& st = r.stats;
     std::printf("object %s (%zu triangles), area %s (%zu triangles), backend %s\n",
                 args["--object"].c_str(), object.triangles.size(), args["--area"].c_str(),
@@ -123,7 +135,11 @@ int main(int argc, char** argv) {
       o.precision(9);
       o << "{\"object\": \"" << args["--object"] << "\", \"area\": \"" << args["--area"]
         << "\", \"planning_ms\": " << st.total_ms << ", \"first_stable_ms\": " << st.first_stable_ms
-        << ", \"floor_points\": " << st.floor_points_total << ", \"candidates\": [";
+        << ", \"floor_points\": " << st.floor_points_total << ", \"gravity\": ";
+      vecJson(o, c.gravity);
+      o << ", \"warnings\": [";
+      for (size_t i = 0; i < r.warnings.size(); ++i) o << (i ? ", " : "") << "\"" << r.warnings[i] << "\"";
+      o << "], \"candidates\": [";
       for (size_t i = 0; i < r.candidates.size(); ++i) {
         const auto& k = r.candidates[i];
         o << (i ? ", " : "") << "{\"position\": ";

@@ -4,7 +4,7 @@
 //
 //   place_planner_suite --data ../shared/data --out DIR [--plots DIR] [--pairs SUBSTR,...]
 //       [--holes 0.05,0.1,0.2 | --holes none] [--no-fig6] [--max-validated 5] [--max-drops 16]
-//       [--threads 1] [--friction 0.2]
+//       [--threads 1] [--friction 0.2] [--auto-gravity]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -45,7 +45,9 @@ double median(std::vector<double> v) {
   std::fprintf(stderr,
                "%s\nusage: place_planner_suite --data DIR --out DIR [--plots DIR] [--pairs S,...]\n"
                "  [--holes 0.05,0.1,0.2|none] [--no-fig6] [--max-validated N] [--max-drops N]\n"
-               "  [--threads N] [--friction MU]\n",
+               "  [--threads N] [--friction MU] [--auto-gravity]\n"
+               "  --auto-gravity: areas with under 5 %% of their surface facing up are planned and\n"
+               "  validated with gravity against their largest flat region (area_up.h)\n",
                msg);
   std::exit(2);
 }
@@ -119,6 +121,7 @@ int main(int argc, char** argv) {
     else if (a == "--max-drops") cfg.max_drops = std::stoi(next());
     else if (a == "--threads") cfg.planner.threads = std::stoi(next());
     else if (a == "--friction") cfg.planner.friction = std::stod(next());
+    else if (a == "--auto-gravity") cfg.auto_gravity = true;
     else usage(("unknown argument " + a).c_str());
   }
   if (out.empty()) usage("--out is required");

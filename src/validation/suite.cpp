@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "place_planner/area_up.h"
 #include "place_planner/mesh_io.h"
 #include "place_planner/scenes.h"
 #include "place_planner/validation/mesh_variants.h"
@@ -145,7 +146,10 @@ SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh&
     r.object_triangles = static_cast<int>(object.triangles.size());
 
     // Planner.
-    const PlanResult plan = Planner().plan(object, area, config.planner);
+    PlannerConfig pc = config.planner;
+    const Eigen::Vector3d g0 = pc.gravity.norm() > 1e-9 ? Eigen::Vector3d(pc.gravity) : -Eigen::Vector3d::UnitZ();
+    if (config.auto_gravity && upFacingShare(area, -g0) < 0.05) pc.gravity = -estimateUp(area, -g0).up;
+    const PlanResult plan = Planner().plan(object, area, pc);
     r.stats = plan.stats;
     r.candidates = static_cast<int>(plan.candidates.size());
     for (const auto& c : plan.candidates) r.stable += c.stable ? 1 : 0;
@@ -155,8 +159,7 @@ SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh&
     // Physics check of the best-ranked stable candidates, on the full object mesh.
     ValidatorConfig vc = config.validator;
     vc.friction = config.planner.friction;
-    if (config.planner.gravity.norm() > 1e-9)
-      vc.gravity = 9.81 * config.planner.gravity.normalized();
+    if (pc.gravity.norm() > 1e-9) vc.gravity = 9.81 * pc.gravity.normalized();
     const PhysicsValidator validator(object_full, area, vc);
     const auto t0 = Clock::now();
     for (size_t k = 0; k < plan.candidates.size() && r.validated < config.max_validated; ++k) {

@@ -1,10 +1,12 @@
 // Each step of the planner on hand-checkable cases.
 #include <algorithm>
 
+#include "place_planner/area_up.h"
 #include "place_planner/backend.h"
 #include "place_planner/contact_points.h"
 #include "place_planner/floor_points.h"
 #include "place_planner/kernels/geometry.h"
+#include "place_planner/planner.h"
 #include "place_planner/pre_orientation.h"
 #include "place_planner/quality.h"
 #include "place_planner/stability.h"
@@ -294,4 +296,28 @@ TEST(FeatureEdges, RidgesOnlyOnSolids) {
   const Mesh open = buildMesh(v, open_faces, "l_prism_open");
   EXPECT_EQ(featureEdges(open).size(), 18u);
   EXPECT_TRUE(reflexEdgeKept(open));
+}
+
+// A table seen from a tilted camera: the largest flat region's normal is recovered, turned to
+// the side where the box on it stands, and the planner warns under the default gravity.
+TEST(AreaUp, TiltedSceneIsRecognised) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.9, Eigen::Vector3d(1, 0.2, 0).normalized()).toRotationMatrix();
+  const Mesh scene = transformed(scenes::merge({scenes::plane(0.8, 0.6), scenes::box(0.1, 0.1, 0.2, {0.1, 0, 0.1})}),
+                                 R, Eigen::Vector3d(0.1, -0.2, 0.3));
+  const UpEstimate e = estimateUp(scene);
+  EXPECT_GT(e.up.dot(R * Eigen::Vector3d::UnitZ()), std::cos(1.0 * M_PI / 180.0));
+  EXPECT_GT(e.share, 0.5);
+  EXPECT_LT(upFacingShare(scene, Eigen::Vector3d::UnitZ()), 0.05);
+  EXPECT_NEAR(upFacingShare(scenes::table(), Eigen::Vector3d::UnitZ()), 1.0, 0.3);
+
+  PlannerConfig c;
+  c.max_candidates = 3;
+  const PlanResult wrong = Planner().plan(scenes::box(0.05, 0.05, 0.05), scene, c);
+  ASSERT_EQ(wrong.warnings.size(), 1u);
+  EXPECT_NE(wrong.warnings[0].find("is gravity right?"), std::string::npos);
+  c.gravity = -e.up;
+  const PlanResult right = Planner().plan(scenes::box(0.05, 0.05, 0.05), scene, c);
+  EXPECT_TRUE(right.warnings.empty());
+  ASSERT_FALSE(right.candidates.empty());
+  EXPECT_TRUE(right.candidates[0].stable);
 }

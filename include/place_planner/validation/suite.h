@@ -34,6 +34,9 @@ struct SuiteConfig {
   int max_drops = 8;            // floor points dropped per scene (evenly spread); 0 = none
   double hole_fraction = 0.0;   // > 0: plan on a copy with this fraction deleted in patches
   std::uint32_t hole_seed = 1;
+  // Where under 5 % of an area faces against planner.gravity (a scan in its camera frame),
+  // plan and validate with gravity against the area's largest flat region (area_up.h).
+  bool auto_gravity = false;
   SuiteConfig() { planner.threads = 1; }
 };
 

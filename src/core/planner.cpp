@@ -288,31 +288,40 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     return true;
   };
 
-  // Roots are processed in groups so good poses appear early (anytime behaviour).
-  // The first group is small so the first stable pose comes quickly.
-  const int group = std::max(16, 12 * resolveThreads(config.threads));
+  // Roots are streamed into the batch (anytime behaviour): whenever trees end, new roots take
+  // their places, so a pose that settles in a few steps is not held up by a long tree and the
+  // batch stays full. The batch starts small (the first stable pose comes quickly) and doubles
+  // every other step up to `batch`. Each tree depends on its root only: the leaves are the same.
+  const int batch = std::max(16, 12 * resolveThreads(config.threads));
+  std::vector<Node> translate, contact, rotating;
+  int next_root = 0;
+  auto startRoot = [&](int k) {
+    const int f = k / static_cast<int>(orientations.size());
+    const Eigen::Matrix3d& R = orientations[k % orientations.size()];
+    const V3 p_f = fp.points[f];
+    // Centre of mass above the floor point along -d_vis, clear of everything (V-A).
+    const double h = hmax + dot(p_f, d_vis) + R_obj + 0.01;
+    const Eigen::Vector3d com_G = toEigen(p_f) - h * toEigen(d_vis);
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.linear() = R;
+    X.translation() = com_G - R * object.properties.center_of_mass;
+    Node n;
+    n.X = toRigid(X);
+    n.root = k;
+    n.path.push_back(n.X);  // pre-placement pose
+    n.pending.push_back(d_vis);
+    n.pending_tmax.push_back(h + R_obj + (hmax - hmin) + 0.01);
+    translate.push_back(std::move(n));
+  };
   bool stop = !report();
-  for (int g0 = 0, gsize = std::max(4, group / 6); g0 < num_roots && !stop; g0 += gsize, gsize = group) {
-    std::vector<Node> translate, contact, rotating;
-    for (int k = g0; k < std::min(num_roots, g0 + gsize); ++k) {
-      const int f = k / static_cast<int>(orientations.size());
-      const Eigen::Matrix3d& R = orientations[k % orientations.size()];
-      const V3 p_f = fp.points[f];
-      // Centre of mass above the floor point along -d_vis, clear of everything (V-A).
-      const double h = hmax + dot(p_f, d_vis) + R_obj + 0.01;
-      const Eigen::Vector3d com_G = toEigen(p_f) - h * toEigen(d_vis);
-      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-      X.linear() = R;
-      X.translation() = com_G - R * object.properties.center_of_mass;
-      Node n;
-      n.X = toRigid(X);
-      n.root = k;
-      n.path.push_back(n.X);  // pre-placement pose
-      n.pending.push_back(d_vis);
-      n.pending_tmax.push_back(h + R_obj + (hmax - hmin) + 0.01);
-      translate.push_back(std::move(n));
-    }
-    while (!translate.empty() || !contact.empty() || !rotating.empty()) {
+  const int first_batch = std::max(4, batch / 6);
+  for (int step = 0, target = first_batch; !stop; ++step) {
+    if (step > 0 && step % 2 == 0) target = std::min(batch, 2 * target);
+    for (size_t active = translate.size() + contact.size() + rotating.size();
+         static_cast<int>(active) < target && next_root < num_roots; ++active)
+      startRoot(next_root++);
+    if (translate.empty() && contact.empty() && rotating.empty()) break;
+    {  // one batched step of every pending pose
       // -------------------------------------------------------------- distance kernel (V-A)
       if (!translate.empty()) {
         tp = Clock::now();
@@ -468,13 +477,15 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
         }
         rotating.clear();
       }
-      if (!report()) {
-        stop = true;
-        break;
-      }
     }
-    st.floor_points_done = std::min(num_roots, g0 + gsize) / static_cast<int>(orientations.size());
-    if (!stop && !report()) stop = true;
+    // Floor points done: roots started whose trees have all ended.
+    std::vector<int> open;
+    for (const auto* list : {&translate, &contact, &rotating})
+      for (const Node& n : *list) open.push_back(n.root);
+    std::sort(open.begin(), open.end());
+    const int open_roots = static_cast<int>(std::unique(open.begin(), open.end()) - open.begin());
+    st.floor_points_done = (next_root - open_roots) / static_cast<int>(orientations.size());
+    if (!report()) stop = true;
   }
 
   // ------------------------------------------------------------------ candidates

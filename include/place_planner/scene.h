@@ -51,6 +51,7 @@ struct ObjectModel : MeshModel {  // frame O
 struct AreaModel : MeshModel {  // frame G
   HeightGrid grid;
   Eigen::Matrix3d R_GW;  // rotation from the planning frame W into G
+  double up_facing_share = 1.0;  // of the surface, facing against gravity (area_up.h)
 };
 
 // Edges for the edge/edge tests: all but those between two (nearly) coplanar triangles. A

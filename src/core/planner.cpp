@@ -153,16 +153,6 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   const Eigen::Vector3d d_g_W = config.gravity.normalized();
   const Eigen::Vector3d d_vis_W =
       config.approach.norm() > 1e-9 ? Eigen::Vector3d(config.approach.normalized()) : d_g_W;
-  // With gravity wrong for the area (a scan in its camera frame) nothing is flat; say so.
-  if (upFacingShare(area, -d_g_W) < kMinUpFacingShare) {
-    const UpEstimate e = estimateUp(area, -d_g_W);
-    char msg[320];
-    std::snprintf(msg, sizeof msg,
-                  "placement area: under %.0f %% of its surface faces against gravity; its largest "
-                  "flat region (%.0f %%) faces (%.3f, %.3f, %.3f): is gravity right?",
-                  100 * kMinUpFacingShare, 100 * e.share, e.up.x(), e.up.y(), e.up.z());
-    result.warnings.push_back(msg);
-  }
   const double R_obj = object.properties.bounding_radius;
   // Sphere radius: about 1% of the object's size, within 0.75 .. 4 mm (Section V-B).
   const double r = config.sphere_radius > 0 ? config.sphere_radius
@@ -180,6 +170,16 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   const AreaModel& am = *area_model;
   const Eigen::Matrix3d R_GW = am.R_GW;
   st.steps.setup = msSince(tp);
+  // With gravity wrong for the area (a scan in its camera frame) nothing is flat; say so.
+  if (am.up_facing_share < kMinUpFacingShare) {
+    const UpEstimate e = estimateUp(area, -d_g_W);
+    char msg[320];
+    std::snprintf(msg, sizeof msg,
+                  "placement area: under %.0f %% of its surface faces against gravity; its largest "
+                  "flat region (%.0f %%) faces (%.3f, %.3f, %.3f): is gravity right?",
+                  100 * kMinUpFacingShare, 100 * e.share, e.up.x(), e.up.y(), e.up.z());
+    result.warnings.push_back(msg);
+  }
   const V3 d_vis = toV3(R_GW * d_vis_W);
   const V3 d_g = v3(0, 0, -1);
 

@@ -6,6 +6,8 @@
 #include <future>
 #include <map>
 
+#include "place_planner/area_up.h"
+
 namespace place_planner {
 
 Rigid toRigid(const Eigen::Isometry3d& T) {
@@ -158,6 +160,7 @@ AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, d
         grid = buildHeightGrid(sm, bounds, collision_distance, grid_cell);
       });
   a.grid = std::move(grid);
+  a.up_facing_share = upFacingShare(area_W, -gravity_W);
   return a;
 }
 

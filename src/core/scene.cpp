@@ -48,20 +48,41 @@ std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg) 
       ++u.count;
       u.forward += fwd;
     }
-  // Which side is solid: on a consistently wound, (nearly) closed surface the winding's normals
-  // point out where the signed volume is positive and in where it is negative. Open sheets and
-  // scans (more than 2 % border edges) have no inside: every side may be touched.
-  int border = 0;
-  bool consistent = true;
+  // Which side is solid, per connected piece (a scene may merge parts wound either way): on a
+  // consistently wound, (nearly) closed piece the winding's normals point out where its signed
+  // volume is positive and in where it is negative. Open sheets and scans (more than 2 % border
+  // edges) have no inside: every side may be touched (outward 0).
+  std::vector<int> piece(mesh.triangles.size());
+  for (size_t t = 0; t < piece.size(); ++t) piece[t] = static_cast<int>(t);
+  auto find = [&](int t) {
+    while (piece[t] != t) t = piece[t] = piece[piece[t]];
+    return t;
+  };
+  for (const auto& e : uses)
+    if (e.second.count == 2) piece[find(e.second.tris[0])] = find(e.second.tris[1]);
+  struct Piece {
+    int edges = 0, border = 0;
+    bool consistent = true;
+    double volume = 0;
+  };
+  std::map<int, Piece> pieces;
   for (const auto& e : uses) {
-    border += e.second.count == 1;
-    if (e.second.count == 2 && e.second.forward != 1) consistent = false;
+    Piece& p = pieces[find(e.second.tris[0])];
+    ++p.edges;
+    p.border += e.second.count == 1;
+    if (e.second.count == 2 && e.second.forward != 1) p.consistent = false;
   }
-  double volume = 0;
   const Eigen::Vector3d o = mesh.properties.center_of_mass;
-  for (const auto& t : mesh.triangles)
-    volume += (mesh.vertices[t[0]] - o).dot((mesh.vertices[t[1]] - o).cross(mesh.vertices[t[2]] - o));
-  const int outward = consistent && border <= 0.02 * uses.size() ? (volume > 0) - (volume < 0) : 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    pieces[find(static_cast<int>(t))].volume +=
+        (mesh.vertices[tri[0]] - o).dot((mesh.vertices[tri[1]] - o).cross(mesh.vertices[tri[2]] - o));
+  }
+  auto outward = [&](int t) {
+    const Piece& p = pieces[find(t)];
+    if (!p.consistent || p.border > 0.02 * p.edges) return 0;
+    return (p.volume > 0) - (p.volume < 0);
+  };
 
   const double cos_flat = std::cos(flat_deg * M_PI / 180.0);
   auto normal = [&](int t) {
@@ -80,11 +101,11 @@ std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg) 
       // Concave (valley) edge of a solid: the free space around it is a wedge narrower than a
       // half-space, which another edge can only touch along the valley, never across it; such
       // contacts start at an end point (a vertex/patch test). Only ridges meet edge against edge.
-      if (outward != 0) {
+      if (const int out_sign = outward(t1)) {
         int c = 0;  // the vertex of t2 off the edge
         for (int k = 0; k < 3; ++k)
           if (mesh.triangles[t2][k] != e[0] && mesh.triangles[t2][k] != e[1]) c = mesh.triangles[t2][k];
-        if (outward * n1.dot(mesh.vertices[c] - mesh.vertices[e[0]]) > 0) continue;
+        if (out_sign * n1.dot(mesh.vertices[c] - mesh.vertices[e[0]]) > 0) continue;
       }
     }
     out.push_back(e);

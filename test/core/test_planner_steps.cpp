@@ -321,3 +321,19 @@ TEST(AreaUp, TiltedSceneIsRecognised) {
   ASSERT_FALSE(right.candidates.empty());
   EXPECT_TRUE(right.candidates[0].stable);
 }
+
+// Orientation is judged per connected piece: an L-prism wound inside out merged with a box
+// wound outward still loses only its valley.
+TEST(FeatureEdges, OrientationPerPiece) {
+  const std::vector<Eigen::Vector2d> l = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  std::vector<Eigen::Vector3d> v;
+  for (double z : {0.0, 1.0})
+    for (const auto& p : l) v.emplace_back(p.x(), p.y(), z);
+  std::vector<std::vector<int>> faces = {{0, 1, 2, 3, 4, 5}, {11, 10, 9, 8, 7, 6}};
+  for (int i = 0; i < 6; ++i) faces.push_back({6 + i, 6 + (i + 1) % 6, (i + 1) % 6, i});  // inside out
+  const Mesh l_prism = buildMesh(v, faces, "l_prism_inside_out");
+  const Mesh big_box = scenes::box(4, 4, 4, {10, 0, 0});  // outward, much larger volume
+  const Mesh both = scenes::merge({l_prism, big_box});
+  // 17 of the prism's 18 edges and the box's 12.
+  EXPECT_EQ(featureEdges(both).size(), 17u + 12u);
+}

@@ -40,7 +40,7 @@ PP_HD double boxVolume(const Aabb& b) {
 
 // Simultaneous traversal of two BVHs: for every pair of leaves whose boxes overlap (A's node
 // boxes first mapped by boxA: posed, swept along a translation or an arc), calls
-// prep(primitive of A) -> data once per primitive of A and leaf pair, then
+// prep(primitive of A) -> data once per leaf of A and subtree of B it reaches, then
 // leaf(data, primitive of A, primitive of B). Replaces one root-to-leaf query per primitive
 // of A (the paper's kd-restart per ray) by one walk over both trees.
 constexpr int kPairStack = 2 * kBvhStack;

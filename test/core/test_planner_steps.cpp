@@ -263,37 +263,45 @@ TEST(SphereModel, SpacingAndGridHeights) {
     if (am.grid.start[k + 1] > am.grid.start[k]) EXPECT_NEAR(am.grid.max_z[k], 0.01, 1e-12);
 }
 
-// Edge/edge candidates (scene.h): on a solid, a valley edge is dropped (only ridges can touch
-// across); on an open sheet it is kept; the winding's sign does not matter.
-TEST(FeatureEdges, RidgesOnlyOnSolids) {
-  // L-shaped prism: the cross-section has one reflex corner at (1, 1), whose vertical edge is
-  // the only valley.
+// L-shaped prism: the cross-section has one reflex corner at (1, 1), whose vertical edge
+// (vertices 3 and 9) is the only valley. Polygons wound outward; reversed when inside_out;
+// without its top cap (an open sheet) when open.
+namespace {
+// L-shaped prism, wound outward: the cross-section's reflex corner at (1, 1) gives the only
+// valley edge (vertices 3 and 9). inside_out reverses every polygon; open drops the top cap.
+Mesh lPrism(bool inside_out = false, bool open = false) {
   const std::vector<Eigen::Vector2d> l = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
   std::vector<Eigen::Vector3d> v;
   for (double z : {0.0, 1.0})
     for (const auto& p : l) v.emplace_back(p.x(), p.y(), z);
-  std::vector<std::vector<int>> faces = {{5, 4, 3, 2, 1, 0}, {6, 7, 8, 9, 10, 11}};
+  std::vector<std::vector<int>> faces = {{5, 4, 3, 2, 1, 0}};
+  if (!open) faces.push_back({6, 7, 8, 9, 10, 11});
   for (int i = 0; i < 6; ++i) faces.push_back({i, (i + 1) % 6, 6 + (i + 1) % 6, 6 + i});
+  if (inside_out)
+    for (auto& f : faces) std::reverse(f.begin(), f.end());
+  return buildMesh(v, faces, "l_prism");
+}
+}  // namespace
+
+// Edge/edge candidates (scene.h): on a solid, a valley edge is dropped (only ridges can touch
+// across); on an open sheet it is kept; the winding's sign does not matter.
+TEST(FeatureEdges, RidgesOnlyOnSolids) {
   auto reflexEdgeKept = [](const Mesh& m) {
     for (const auto& e : featureEdges(m))
       if ((e[0] == 3 && e[1] == 9) || (e[0] == 9 && e[1] == 3)) return true;
     return false;
   };
-  const Mesh solid = buildMesh(v, faces, "l_prism");
+  const Mesh solid = lPrism();
   // 6 top + 6 bottom + 6 vertical edges; the fan diagonals of the caps are flat.
   EXPECT_EQ(featureEdges(solid).size(), 17u);
   EXPECT_FALSE(reflexEdgeKept(solid));
 
-  auto flipped = faces;
-  for (auto& f : flipped) std::reverse(f.begin(), f.end());
-  const Mesh inside_out = buildMesh(v, flipped, "l_prism_flipped");
+  const Mesh inside_out = lPrism(true);
   EXPECT_EQ(featureEdges(inside_out).size(), 17u);
   EXPECT_FALSE(reflexEdgeKept(inside_out));
 
   // Without its top cap the prism is an open sheet: both sides can be touched.
-  auto open_faces = faces;
-  open_faces.erase(open_faces.begin() + 1);
-  const Mesh open = buildMesh(v, open_faces, "l_prism_open");
+  const Mesh open = lPrism(false, true);
   EXPECT_EQ(featureEdges(open).size(), 18u);
   EXPECT_TRUE(reflexEdgeKept(open));
 }
@@ -325,13 +333,7 @@ TEST(AreaUp, TiltedSceneIsRecognised) {
 // Orientation is judged per connected piece: an L-prism wound inside out merged with a box
 // wound outward still loses only its valley.
 TEST(FeatureEdges, OrientationPerPiece) {
-  const std::vector<Eigen::Vector2d> l = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
-  std::vector<Eigen::Vector3d> v;
-  for (double z : {0.0, 1.0})
-    for (const auto& p : l) v.emplace_back(p.x(), p.y(), z);
-  std::vector<std::vector<int>> faces = {{0, 1, 2, 3, 4, 5}, {11, 10, 9, 8, 7, 6}};
-  for (int i = 0; i < 6; ++i) faces.push_back({6 + i, 6 + (i + 1) % 6, (i + 1) % 6, i});  // inside out
-  const Mesh l_prism = buildMesh(v, faces, "l_prism_inside_out");
+  const Mesh l_prism = lPrism(true);
   const Mesh big_box = scenes::box(4, 4, 4, {10, 0, 0});  // outward, much larger volume
   const Mesh both = scenes::merge({l_prism, big_box});
   // 17 of the prism's 18 edges and the box's 12.

@@ -8,6 +8,8 @@
 namespace place_planner {
 
 enum class OrientationMode {
+  kAuto,           // default: resting faces of the hull, the held orientation, the principal
+                   // axis and turns about d_vis where the area has direction, likeliest first
   kPrincipalAxis,  // Section IV-A: k1 of the object parallel to the approach direction
   kKeep,           // keep the orientation the object is given in
   kAllAxes,        // try +-k1, +-k2, +-k3 along the approach direction
@@ -25,7 +27,14 @@ struct PlannerConfig {
   int max_rotations = 5;                     // depth of the rotation tree (Section VII-C)
   double sphere_radius = 0.0;                // m, surface sphere model; 0 = derived from sizes
   double grid_cell_size = 0.0;               // m, 2D height grid; 0 = derived from sphere radius
-  OrientationMode orientation = OrientationMode::kPrincipalAxis;
+  OrientationMode orientation = OrientationMode::kAuto;
+  int max_resting_faces = 6;                 // kAuto: resting faces tried, best tipping margin first
+  // Robust stability (robustness.cpp): a stable pose must also hold when released off it.
+  double robust_shift = 0.003;               // m, horizontal release offset delta
+  double robust_tilt_deg = 3.0;              // release tilt epsilon
+  double robust_com_offset = 0.05;           // centre of mass off by this share of the object's size
+  double robust_min_share = 1.0;             // share of perturbed releases that must hold
+  bool robust_check = true;                  // false: static stability only (the paper)
   double time_budget_ms = 0.0;               // 0 = no budget
   int max_candidates = 10;                   // after ranking and merging
   int threads = 0;                           // 0 = all hardware threads

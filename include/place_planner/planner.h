@@ -18,10 +18,37 @@ struct ContactPoint {
   Eigen::Vector3d n_W = Eigen::Vector3d::UnitZ(); // unit normal, pointing at the object
 };
 
+// How a stable pose holds when it is released a little off it (robustness.cpp): each trial
+// shifts the release horizontally, tilts it or moves the centre of mass, settles it with the
+// planner's own kernels, and holds when it ends stable within 1 cm and 5 degrees of the pose.
+struct Robustness {
+  int trials = 0;                  // perturbed releases settled (0: not checked)
+  int held = 0;                    // ... that came to rest near the pose, stable
+  double min_tipping_angle = 0.0;  // rad, smallest tilt that tips it over, over the trials
+  double share() const { return trials > 0 ? static_cast<double>(held) / trials : 0.0; }
+};
+
+// A physics engine's verdict (Bullet, validation::verifyTopK; filled by the CLI and the node
+// when verify_top_k > 0, never by the core planner).
+struct PhysicsCheck {
+  bool checked = false;   // false: not simulated (not in the top K, or out of time)
+  bool stayed = false;    // moved < 1 cm and turned < 5 degrees after release
+  double moved_m = 0.0;
+  double turned_deg = 0.0;
+};
+
+// Which start orientation a candidate's tree began from (Section IV-A, generalised).
+enum class StartKind { kRestingFace, kHeld, kPrincipalAxis, kAreaTurn, kAxis };
+const char* toString(StartKind k);
+
 struct Candidate {
   Eigen::Isometry3d X_WO = Eigen::Isometry3d::Identity();  // goal pose of the object mesh frame
   double quality = 0.0;                                     // Q (Section VI), <= 1
-  bool stable = false;
+  bool stable = false;             // statically stable and robust (see Robustness)
+  Robustness robustness;
+  PhysicsCheck physics;
+  StartKind start = StartKind::kPrincipalAxis;
+  double reorientation = 0.0;      // rad, rotation from the held orientation to the goal
   std::vector<ContactPoint> contacts;                       // at the goal pose
   Eigen::Vector3d floor_point_W = Eigen::Vector3d::Zero();
   // Ordered: pre-placement pose above the floor point first, one per translation or rotation,
@@ -36,15 +63,31 @@ struct StepTimes {  // wall time per batched step, ms
 };
 
 struct PlanStats {
+  int roots_total = 0;             // floor points x start orientations
+  int start_orientations = 0;
+  int trees_without_rest = 0;      // trees cut by max_rotations before reaching a resting pose
+  int robustness_checked = 0;      // stable leaves whose releases were perturbed
+  int robustness_rejected = 0;     // ... found not robust (returned as not stable)
   int floor_points_total = 0;
   int floor_points_done = 0;
   long tree_nodes = 0;             // poses evaluated over all trees
   double first_stable_ms = -1.0;   // -1: none found
   double total_ms = 0.0;
   StepTimes steps;
+  double robustness_ms = 0.0;      // wall time of the robustness check
   std::string backend;             // "cpu" or "cuda"
   double sphere_radius = 0.0;      // as used (derived when the config says 0)
 };
+
+// What a plan came to; the CLI's exit code and the node's error code follow it.
+enum class PlanOutcome {
+  kStable,               // at least one stable candidate, search complete
+  kNoStable,             // search complete, nothing stable
+  kTimedOutWithStable,   // budget ran out; stable candidates so far (a partial answer)
+  kTimedOutNone,         // budget ran out before anything stable
+  kCancelled,            // the progress callback said stop
+};
+const char* toString(PlanOutcome o);
 
 struct PlanResult {
   std::vector<Candidate> candidates;  // ranked: stable first, then by quality
@@ -55,6 +98,8 @@ struct PlanResult {
   // Doubts about the input that did not stop the plan, one sentence each (e.g. an area with
   // almost nothing facing against gravity: a scan in its camera frame?).
   std::vector<std::string> warnings;
+  PlanOutcome outcome() const;
+  int stableCount() const;
 };
 
 struct Progress {

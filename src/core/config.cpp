@@ -58,22 +58,34 @@ void validate(const PlannerConfig& c) {
   require(std::isfinite(c.min_quality) && c.min_quality <= 1, "min_quality", c.min_quality, "<= 1");
   require(std::isfinite(c.merge_distance) && c.merge_distance >= 0, "merge_distance",
           c.merge_distance, ">= 0");
+  require(c.max_resting_faces >= 0 && c.max_resting_faces <= 64, "max_resting_faces",
+          c.max_resting_faces, "0 .. 64");
+  require(std::isfinite(c.robust_shift) && c.robust_shift >= 0 && c.robust_shift <= 0.05,
+          "robust_shift", c.robust_shift, "0 .. 0.05 m");
+  require(std::isfinite(c.robust_tilt_deg) && c.robust_tilt_deg >= 0 && c.robust_tilt_deg <= 20,
+          "robust_tilt_deg", c.robust_tilt_deg, "0 .. 20");
+  require(std::isfinite(c.robust_com_offset) && c.robust_com_offset >= 0 && c.robust_com_offset <= 0.3,
+          "robust_com_offset", c.robust_com_offset, "0 .. 0.3 (share of the object's size)");
+  require(std::isfinite(c.robust_min_share) && c.robust_min_share >= 0 && c.robust_min_share <= 1,
+          "robust_min_share", c.robust_min_share, "0 .. 1");
   require(std::isfinite(c.merge_angle_deg) && c.merge_angle_deg >= 0, "merge_angle_deg",
           c.merge_angle_deg, ">= 0");
 }
 
 OrientationMode orientationModeFromString(const std::string& s) {
-  if (s == "principal_axis" || s.empty()) return OrientationMode::kPrincipalAxis;
+  if (s == "auto" || s.empty()) return OrientationMode::kAuto;
+  if (s == "principal_axis") return OrientationMode::kPrincipalAxis;
   if (s == "keep") return OrientationMode::kKeep;
   if (s == "all_axes") return OrientationMode::kAllAxes;
   throw std::invalid_argument("orientation_mode = '" + s +
-                              "' is unknown (use principal_axis, keep or all_axes)");
+                              "' is unknown (use auto, principal_axis, keep or all_axes)");
 }
 
 std::string toString(OrientationMode m) {
   switch (m) {
     case OrientationMode::kKeep: return "keep";
     case OrientationMode::kAllAxes: return "all_axes";
+    case OrientationMode::kAuto: return "auto";
     default: return "principal_axis";
   }
 }

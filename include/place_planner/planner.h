@@ -5,6 +5,7 @@
 #pragma once
 #include <Eigen/Geometry>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -114,17 +115,24 @@ struct Progress {
 // candidates found so far with cancelled = true.
 using ProgressCallback = std::function<bool(const Progress&)>;
 
+class AreaModelCache;
+
 class Planner {
  public:
+  Planner();
   // object: M_O in its own frame O. area: M_P in the planning frame W.
   // Throws std::invalid_argument for a bad config (naming the field).
   PlanResult plan(const Mesh& object, const Mesh& area, const PlannerConfig& config,
                   const ProgressCallback& progress = {}) const;
 
-  // The prepared area (sphere model, BVHs, height grid) of the last few areas is cached across
-  // calls, as a robot places several objects on one area; stats.steps.setup shows the cost.
-  // This drops the cache (benchmarks of cold starts).
-  static void clearAreaCache();
+  // The prepared area (sphere model, BVHs, height grid) of the last few areas is kept by this
+  // planner (and its copies), as a robot places several objects on one area; objects of
+  // similar size share one model (area_model_cache.h); stats.steps.setup shows the cost.
+  // This drops it (benchmarks of cold starts).
+  void clearAreaCache() const;
+
+ private:
+  std::shared_ptr<AreaModelCache> cache_;
 };
 
 }  // namespace place_planner

@@ -50,8 +50,13 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
 double nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd* x = nullptr);
 
 // True when non-negative contact forces inside friction pyramids (4 edges, inscribed) balance
-// the unit force `f_ext` applied at `com` (force and torque).
+// the force `f_ext` applied at `com` (force and torque) with a total normal force of at most
+// max_load |f_ext|: the least loaded balancing forces are found. Gravity alone loads a floor,
+// a V-groove or a leaning support with about 1-1.5 times the weight; a wedge held between walls
+// by squeeze needs at least |f_ext| / mu, so with the default bound of 2 (and mu <= 0.25) a
+// statically indeterminate wedge is not accepted.
 bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
-                 const Eigen::Vector3d& f_ext, double friction, double length_scale);
+                 const Eigen::Vector3d& f_ext, double friction, double length_scale,
+                 double max_load = 2.0);
 
 }  // namespace place_planner

@@ -10,8 +10,6 @@ namespace place_planner {
 namespace {
 
 const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();  // -d_g in G
-// A contact "opposes" the failure direction when its normal is within this angle of -d'_f.
-const double kOpposingAngle = 60.0 * M_PI / 180.0;
 
 // 2D analysis of a support polygon in the plane through `origin` with normal `n` (unit),
 // centre of mass projected along gravity (-z).
@@ -169,11 +167,15 @@ double nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd*
 }
 
 bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
-                 const Eigen::Vector3d& f_ext, double friction, double L) {
+                 const Eigen::Vector3d& f_ext, double friction, double L, double max_load) {
   if (contacts.empty()) return false;
   // Inscribed 4-edge pyramid: conservative against the true cone.
   const double mu = friction / std::sqrt(2.0);
-  Eigen::MatrixXd A(6, 4 * contacts.size());
+  const int m = static_cast<int>(4 * contacts.size());
+  // Rows: force (3), torque (3), and a small weight on the total normal force, so that of all
+  // balancing forces the least loaded is found (a wedge's squeeze is not free).
+  constexpr double kLoadWeight = 1e-3;
+  Eigen::MatrixXd A(7, m);
   for (size_t i = 0; i < contacts.size(); ++i) {
     const Eigen::Vector3d n = contacts[i].n_W.normalized();
     const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
@@ -184,11 +186,15 @@ bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3
       const Eigen::Vector3d f = e[k].normalized();
       A.block<3, 1>(0, 4 * i + k) = f;
       A.block<3, 1>(3, 4 * i + k) = r.cross(f) / L;  // torques in units of force
+      A(6, 4 * i + k) = kLoadWeight * f.dot(n);
     }
   }
-  Eigen::VectorXd b(6);
-  b << -f_ext, Eigen::Vector3d::Zero();
-  return nnls(A, b) < 1e-6;
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(7), x;
+  b.head<3>() = -f_ext;
+  nnls(A, b, &x);
+  const double residual = (A.topRows(6) * x - b.head<6>()).norm();
+  const double load = A.row(6).dot(x) / kLoadWeight;  // sum of normal forces
+  return residual < 1e-4 * f_ext.norm() && load <= max_load * f_ext.norm();
 }
 
 // Support polygon of `pts` seen along `dir` (a plane through the centre of mass with normal
@@ -226,6 +232,11 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   std::vector<Eigen::Vector3d> pts;
   for (const auto& p : contacts) pts.push_back(p.p_W);
   // Planar: on one plane and spanning it (contacts on a line lie on every plane through it).
+  // The contacts must push the object up: their mean normal (pointing at the object) against
+  // gravity. Contacts from above (an object pressed under a table) never support it.
+  Eigen::Vector3d nbar = Eigen::Vector3d::Zero();
+  for (const auto& p : contacts) nbar += p.n_W;
+  const bool from_below = nbar.dot(kUp) > 0;
   if (off <= prm.tol && spread2 > prm.tol && n.dot(kUp) > 1e-3) {
     r.planar = true;
     r.plane_normal = n;
@@ -236,7 +247,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     r.tipping_angle = s.tip;
     r.com_inside = s.inside >= 0;
     r.friction_ok = std::acos(std::clamp(n.dot(kUp), -1.0, 1.0)) < cone;  // angle(P, -d_g) < atan(mu)
-    r.stable = r.friction_ok && r.com_inside && s.tip >= prm.min_tipping_angle && s.quality >= 0.3 &&
+    r.stable = from_below && r.friction_ok && r.com_inside && s.tip >= prm.min_tipping_angle && s.quality >= 0.3 &&
                polygonWidth(s.hull2) >= prm.min_support_width;
     if (r.stable) {
       r.failure = Failure::kNone;
@@ -291,16 +302,29 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     df.z() = 0;
     if (df.norm() > 1e-6) {
       df.normalize();
+      // Opposing contacts: normal within the friction cone about -d'_f (the paper's condition).
       std::vector<Eigen::Vector3d> support = below;
       int opposing = 0;
       for (const auto& p : contacts)
-        if (p.n_W.dot(-df) > std::cos(kOpposingAngle)) {
+        if (p.n_W.dot(-df) > std::cos(cone)) {
           support.push_back(p.p_W);
           ++opposing;
         }
       if (opposing > 0) {
         const Support s2 = analyse2(support, df, com);
-        stable = s2.valid && s2.inside >= 0;
+        // Omega'' must face d'_f or the floor within the friction angle (the paper's test):
+        // the normal of the plane through its contacts.
+        Eigen::Vector3d cs = Eigen::Vector3d::Zero();
+        for (const auto& p : support) cs += p;
+        cs /= static_cast<double>(support.size());
+        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+        for (const auto& p : support) cov += (p - cs) * (p - cs).transpose();
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es2(cov);
+        const Eigen::Vector3d n2 = es2.eigenvectors().col(0);
+        const bool spans = es2.eigenvalues()(1) > prm.tol * prm.tol;
+        const double to_df = std::acos(std::min(1.0, std::abs(n2.dot(df))));
+        const double to_up = std::acos(std::min(1.0, std::abs(n2.dot(kUp))));
+        stable = s2.valid && s2.inside >= 0 && spans && std::min(to_df, to_up) < cone;
       }
     }
   }
@@ -317,6 +341,8 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
       stable = equilibrium(contacts, com, g, prm.friction, L);
     }
   }
+  // One contact or a line of contacts never holds (a ball rolls, a cylinder turns about it).
+  if (spread2 <= 0.1 * prm.tol) stable = false;
   r.friction_ok = stable;
   r.stable = stable;
   if (stable) {

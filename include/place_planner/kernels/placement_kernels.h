@@ -158,11 +158,11 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
 // Angle windows traced outward along the circles, like the paper's kd-restart tracing of
 // D(v, A) (Fig. 3): a window's arcs are bounded by small boxes, so only patches the arcs can
 // reach are tested; the search stops once the best angle lies inside the windows done.
-// A tilt beyond 60 degrees turns the object over or off the area; the tree does not follow it
-// (where it lands, other branches and floor points reach directly).
-constexpr int kNumAngleWindows = 2;
+// The windows cover the full tilt range up to a half turn: an object standing on its end tips
+// over until it lies (90 degrees), nothing caps the search before a resting pose.
+constexpr int kNumAngleWindows = 4;
 PP_HD double angleWindowEnd(int k) {
-  const double deg[kNumAngleWindows] = {15, 60};
+  const double deg[kNumAngleWindows] = {15, 45, 100, 180};
   return deg[k] * 0.017453292519943295;
 }
 PP_HD double angleWindowStart(int k) { return k == 0 ? 0.0 : angleWindowEnd(k - 1); }
@@ -190,7 +190,7 @@ struct EdgeArc {
   Aabb box;   // its swept arc over the window
 };
 
-// Vertex/surface rotation: smallest angle theta in (min_angle, 60 deg] by which rotating the
+// Vertex/surface rotation: smallest angle theta in (min_angle, 180 deg] by which rotating the
 // object sigma*theta about (s_A, d_A) brings an object vertex onto an area triangle or an
 // area vertex onto an object triangle. kInf when none below `limit`.
 PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, const Rigid& X_GO,

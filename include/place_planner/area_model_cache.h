@@ -1,0 +1,44 @@
+// The prepared areas (sphere model, BVHs, height grid: the costly part of a plan) of the last
+// few areas, kept by a Planner as a robot places several objects on one area. Frame: the area
+// model is in G (scene.h).
+#pragma once
+#include <Eigen/Core>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "place_planner/mesh.h"
+#include "place_planner/scene.h"
+
+namespace place_planner {
+
+// The area's sphere radius for an object sphere radius r: 1.5 r rounded up to a step of a
+// factor sqrt(2), so objects of similar sizes share one model (and its grid).
+double areaSphereRadius(double object_sphere_radius);
+
+class AreaModelCache {
+ public:
+  explicit AreaModelCache(size_t capacity = 4) : capacity_(capacity) {}
+  // The model of `area_W` for these parameters: from the cache when an entry has the same key
+  // and the same mesh and parameters (checked, not only hashed), else built and kept.
+  std::shared_ptr<const AreaModel> get(const Mesh& area_W, const Eigen::Vector3d& gravity_W,
+                                       double sphere_radius, double collision_distance,
+                                       double grid_cell);
+  void clear();
+  size_t size() const;
+
+ private:
+  struct Entry {
+    uint64_t key;
+    std::vector<Eigen::Vector3d> vertices;
+    std::vector<std::array<int, 3>> triangles;
+    Eigen::Vector3d gravity;
+    double r, cd, cell;
+    std::shared_ptr<const AreaModel> model;
+  };
+  size_t capacity_;
+  mutable std::mutex mutex_;
+  std::vector<Entry> entries_;  // oldest first
+};
+
+}  // namespace place_planner

@@ -1,0 +1,35 @@
+// Candidate ranking (Section VI's Q, with robustness and re-orientation): leaves of all trees
+// into the ranked, merged candidates of a PlanResult. Leaves are in G, candidates in W.
+#pragma once
+#include <Eigen/Geometry>
+#include <functional>
+#include <vector>
+
+#include "place_planner/planner.h"
+#include "place_planner/tree_stepper.h"
+
+namespace place_planner {
+
+struct RankingInput {
+  const std::vector<TreeLeaf>& leaves;
+  const std::vector<StartKind>& root_kind;      // per root index
+  const std::vector<Eigen::Vector3d>& root_floor_point_W;  // per root index
+  Eigen::Matrix3d R_GW;       // planning frame W into G
+  Eigen::Matrix3d R_held_G;   // the held orientation, for the re-orientation key
+  double object_radius = 0;   // m, bounding radius (contact summaries)
+};
+
+// Robustness of the leaves given by index (robustness.h); called on the best stable leaves
+// first, a few at a time, until max_candidates robust ones are found.
+using RobustnessCheck = std::function<std::vector<Robustness>(const std::vector<size_t>&)>;
+
+// Ranks stable before not stable, then by the score
+//   Q - 0.05 * reorientation / pi - 0.05 * (1 - robust share)
+// (re-orientation: the angle from the held orientation, a secondary key: a half turn costs as
+// much as 0.05 of Q), merges poses within merge_distance and merge_angle_deg of a better one,
+// drops Q < min_quality, and checks robustness lazily (config.robust_check): a stable leaf
+// whose share of held trials is below robust_min_share is returned as not stable.
+std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfig& config,
+                                      const RobustnessCheck& check, PlanStats* stats);
+
+}  // namespace place_planner

@@ -1,0 +1,31 @@
+// Robust stability (beyond the paper, whose Fig. 5(c),(f) over-rate poses that hold only at the
+// exact computed pose): a stable pose must also come to rest near it when released a little
+// off it. Frame G (gravity -z).
+#pragma once
+#include <functional>
+#include <vector>
+
+#include "place_planner/planner.h"
+#include "place_planner/tree_stepper.h"
+
+namespace place_planner {
+
+struct RobustnessParams {
+  double shift = 0.003;            // m, horizontal release offset delta (4 directions)
+  double tilt = 3.0 * M_PI / 180;  // rad, release tilt epsilon about 2 horizontal axes (4)
+  double com_offset = 0.05;        // centre of mass moved horizontally (4 directions) by this
+                                   // share of the object's extent along the direction
+  double lift = 0.002;             // m, released this far above the pose
+  double end_distance = 0.01;      // m, a trial holds when it ends this close ...
+  double end_angle = 5.0 * M_PI / 180;  // ... and this little turned, stable
+  int max_rotations = 3;           // of each trial's tree
+};
+
+// Settles 12 perturbed releases of each pose with the planner's own kernels (translation to
+// contact, contact points, a few tilts, local optimisation) and counts those that end stable
+// near it. `keep_going` is asked between batched steps; false stops (unfinished trials fail).
+std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const TreeContext& ctx,
+                                        const RobustnessParams& params,
+                                        const std::function<bool()>& keep_going = {});
+
+}  // namespace place_planner

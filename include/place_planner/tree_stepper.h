@@ -1,0 +1,80 @@
+// The tree of rotations of every pending pose, advanced one batched step at a time (Sections
+// V-A to VI, batched as in VII-C). Frame G (gravity -z). Each tree starts at a root pose with
+// translations pending; its leaves are resting poses (stable or not).
+#pragma once
+#include <Eigen/Core>
+#include <vector>
+
+#include "place_planner/backend.h"
+#include "place_planner/planner.h"
+#include "place_planner/scene.h"
+#include "place_planner/stability.h"
+
+namespace place_planner {
+
+struct TreeNode {
+  Rigid X_GO;
+  int root = 0;       // caller's id of the tree (root index, or robustness trial)
+  int depth = 0;      // rotations of the tree (Section V-C), not counting small ones
+  int turns = 0;      // all rotations, small ones included
+  int opt = 0;        // local optimisation steps (Section VI)
+  V3 com_O{0, 0, 0};  // centre of mass used for stability, frame O (perturbed in trials)
+  std::vector<Rigid> path;      // X_GO after each translation or rotation
+  std::vector<V3> pending;      // translations still to do: directions (G) ...
+  std::vector<double> pending_tmax;  // ... and their search limits (m)
+  // Rotation request (Section V-C): axis through s_A along d_A (G).
+  Eigen::Vector3d s_A = Eigen::Vector3d::Zero(), d_A = Eigen::Vector3d::UnitX();
+  bool both_directions = true;
+  bool local_rotation = false;
+  std::vector<ContactPoint> contacts;  // frame G
+};
+
+struct TreeLeaf {
+  Rigid X_GO;
+  int root = 0;
+  bool stable = false;
+  bool at_rest = true;   // false: cut by max_rotations while still tilting
+  double quality = -1;
+  double tipping_angle = 0;  // rad (planar supports)
+  std::vector<ContactPoint> contacts;  // frame G
+  std::vector<Rigid> path;
+};
+
+struct TreeContext {
+  const ObjectModel& om;
+  const AreaModel& am;
+  Backend& backend;
+  StabilityParams stability;
+  double cd = 0;             // collision distance, m (V-B)
+  int max_rotations = 5;
+  int max_opt = 8;
+  int threads = 0;
+  StepTimes* times = nullptr;  // accumulated per step, may be null
+  long* tree_nodes = nullptr;  // poses evaluated, may be null
+};
+
+class TreeStepper {
+ public:
+  explicit TreeStepper(const TreeContext& ctx);
+  // A tree: its first pose X_GO (also the first entry of its path) and the translation to do.
+  void addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax);
+  size_t active() const { return translate_.size() + contact_.size() + rotating_.size(); }
+  bool empty() const { return active() == 0; }
+  // One batched step of every pending pose; trees that end append their leaves.
+  void step(std::vector<TreeLeaf>& leaves);
+  // Roots with poses still pending, sorted, unique.
+  std::vector<int> openRoots() const;
+
+ private:
+  void firstContactStep();                        // V-A
+  void contactStep(std::vector<TreeLeaf>& leaves);  // V-B, VI, V-C.1
+  void tiltStep();                                // V-C.2
+  TreeContext ctx_;
+  double diag_;  // of the area's bounds, limits slides
+  std::vector<TreeNode> translate_, contact_, rotating_;
+};
+
+// Rotation by `angle` about the axis (s, d) applied after X.
+Rigid rotatedAbout(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector3d& d, double angle);
+
+}  // namespace place_planner

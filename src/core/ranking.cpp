@@ -1,0 +1,129 @@
+// Candidate ranking (ranking.h).
+#include "place_planner/ranking.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "place_planner/contact_points.h"
+
+namespace place_planner {
+namespace {
+
+double angleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a.transpose() * b).angle();
+}
+
+struct Item {
+  size_t leaf;
+  bool stable;
+  double quality, reorientation;
+  Robustness robustness;
+  bool checked = false;
+  double score() const {
+    const double share = checked ? robustness.share() : 1.0;
+    return quality - 0.05 * reorientation / M_PI - 0.05 * (1.0 - share);
+  }
+};
+
+void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
+  std::stable_sort(items.begin(), items.end(), [&](const Item& a, const Item& b) {
+    if (a.stable != b.stable) return a.stable;
+    if (a.score() != b.score()) return a.score() > b.score();
+    return leaves[a.leaf].root < leaves[b.leaf].root;
+  });
+}
+
+}  // namespace
+
+std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfig& config,
+                                      const RobustnessCheck& check, PlanStats* stats) {
+  const auto& leaves = in.leaves;
+  std::vector<Item> items;
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    const TreeLeaf& l = leaves[i];
+    if (l.quality < config.min_quality) continue;
+    items.push_back({i, l.stable, l.quality,
+                     angleBetween(in.R_held_G, toIsometry(l.X_GO).linear()), {}, false});
+  }
+  sortItems(items, leaves);
+  // Merge: a pose near a better one is the same candidate (G and W differ by a rotation only).
+  const double merge_angle = config.merge_angle_deg * M_PI / 180.0;
+  std::vector<Item> distinct;
+  for (const Item& it : items) {
+    const Eigen::Isometry3d X = toIsometry(leaves[it.leaf].X_GO);
+    bool dup = false;
+    for (const Item& k : distinct) {
+      const Eigen::Isometry3d Y = toIsometry(leaves[k.leaf].X_GO);
+      if ((X.translation() - Y.translation()).norm() < config.merge_distance &&
+          angleBetween(X.linear(), Y.linear()) < merge_angle) {
+        dup = true;
+        break;
+      }
+    }
+    if (!dup) distinct.push_back(it);
+  }
+  // Robustness, best stable first, until max_candidates robust ones are found.
+  if (config.robust_check && check) {
+    int robust = 0, checked = 0;
+    size_t next = 0;
+    // Bounded work: at most four times max_candidates leaves are checked.
+    while (robust < config.max_candidates && checked < 4 * config.max_candidates) {
+      std::vector<size_t> batch, where;
+      for (; next < distinct.size() && batch.size() < static_cast<size_t>(config.max_candidates - robust); ++next)
+        if (distinct[next].stable) {
+          batch.push_back(distinct[next].leaf);
+          where.push_back(next);
+        }
+      if (batch.empty()) break;
+      const std::vector<Robustness> rs = check(batch);
+      checked += static_cast<int>(batch.size());
+      for (size_t j = 0; j < where.size(); ++j) {
+        Item& it = distinct[where[j]];
+        it.robustness = rs[j];
+        it.checked = rs[j].trials > 0;
+        const bool ok = it.checked && rs[j].share() >= config.robust_min_share - 1e-9;
+        if (stats) {
+          stats->robustness_checked += it.checked;
+          stats->robustness_rejected += !ok;
+        }
+        it.stable = ok;
+        robust += ok;
+      }
+    }
+    // Stable leaves never checked (out of time, or beyond the candidates needed) are not
+    // claimed stable.
+    for (Item& it : distinct)
+      if (it.stable && !it.checked) it.stable = false;
+    sortItems(distinct, leaves);
+  }
+  const Eigen::Matrix3d R_WG = in.R_GW.transpose();
+  std::vector<Candidate> out;
+  for (const Item& it : distinct) {
+    if (static_cast<int>(out.size()) >= config.max_candidates) break;
+    const TreeLeaf& l = leaves[it.leaf];
+    Candidate c;
+    const Eigen::Isometry3d X_GO = toIsometry(l.X_GO);
+    c.X_WO.linear() = R_WG * X_GO.linear();
+    c.X_WO.translation() = R_WG * X_GO.translation();
+    c.quality = l.quality;
+    c.stable = it.stable;
+    c.robustness = it.robustness;
+    c.start = in.root_kind[l.root];
+    c.reorientation = it.reorientation;
+    // The result summarises the contacts in cells of a third of the object's radius.
+    for (const auto& p : reduceContacts(l.contacts, in.object_radius / 3.0))
+      c.contacts.push_back({R_WG * p.p_W, R_WG * p.n_W});
+    c.floor_point_W = in.root_floor_point_W[l.root];
+    for (const Rigid& X : l.path) {
+      const Eigen::Isometry3d T = toIsometry(X);
+      Eigen::Isometry3d W = Eigen::Isometry3d::Identity();
+      W.linear() = R_WG * T.linear();
+      W.translation() = R_WG * T.translation();
+      c.intermediate_poses.push_back(W);
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace place_planner

@@ -1,0 +1,111 @@
+// Robust stability (robustness.h): perturbed releases settled by the tree stepper.
+#include "place_planner/robustness.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace place_planner {
+namespace {
+
+constexpr int kTrials = 12;
+
+struct Trial {
+  Rigid X_start;  // released here, above the area
+  V3 com_O;
+};
+
+// Trial k of pose X: 0-3 shifted by delta along +-x, +-y; 4-7 tilted by epsilon about +-x,
+// +-y through the centre of mass; 8-11 with the centre of mass moved along +-x, +-y (G).
+Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const RobustnessParams& p) {
+  const Eigen::Vector3d dirs[4] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
+  const Eigen::Vector3d d = dirs[k % 4];
+  Trial t{X, om.com};
+  const Eigen::Vector3d com = toEigen(apply(X, om.com));
+  double lift = p.lift;
+  if (k < 4) {
+    t.X_start.t = t.X_start.t + toV3(p.shift * d);
+  } else if (k < 8) {
+    // Tilted about the horizontal axis perpendicular to d: lifted clear of what it turns into.
+    const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ().cross(d);
+    t.X_start = rotatedAbout(X, com, axis, p.tilt);
+    lift += std::sin(p.tilt) * om.bounding_radius;
+  } else {
+    // The centre of mass off horizontally (G) by com_offset times the object's extent along
+    // that direction (a slender object's error is slender too), expressed in O.
+    double lo = kInf, hi = -kInf;
+    for (const V3& v : om.vertices) {
+      const double x = dot(apply(X, v), toV3(d));
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+    t.com_O = om.com + rotateInv(X, toV3(p.com_offset * (hi - lo) * d));
+  }
+  t.X_start.t = t.X_start.t + v3(0, 0, lift);
+  return t;
+}
+
+double angleBetween(const Rigid& a, const Rigid& b) {
+  return Eigen::AngleAxisd(toIsometry(a).linear().transpose() * toIsometry(b).linear()).angle();
+}
+
+}  // namespace
+
+std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const TreeContext& ctx_in,
+                                        const RobustnessParams& p,
+                                        const std::function<bool()>& keep_going) {
+  TreeContext ctx = ctx_in;
+  ctx.max_rotations = p.max_rotations;
+  ctx.times = nullptr;  // the caller times the whole check
+  TreeStepper stepper(ctx);
+  const ObjectModel& om = ctx.om;
+  for (size_t i = 0; i < X_GO.size(); ++i)
+    for (int k = 0; k < kTrials; ++k) {
+      const Trial t = makeTrial(X_GO[i], k, om, p);
+      const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
+      stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax);
+    }
+  std::vector<TreeLeaf> leaves;
+  bool finished = true;
+  while (!stepper.empty()) {
+    if (keep_going && !keep_going()) {
+      finished = false;
+      break;
+    }
+    stepper.step(leaves);
+  }
+  const std::vector<int> open = finished ? std::vector<int>{} : stepper.openRoots();
+  // A trial holds when it ended (all its leaves: a tree may branch) stable near the pose.
+  std::vector<int> state(X_GO.size() * kTrials, 0);  // 0 no leaf, 1 held, -1 failed
+  std::vector<double> tip(state.size(), kInf);
+  for (const TreeLeaf& l : leaves) {
+    const size_t i = l.root / kTrials;
+    const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(l.X_GO, om.com));
+    const bool near = (c1 - c0).norm() <= p.end_distance && angleBetween(l.X_GO, X_GO[i]) <= p.end_angle;
+    const bool held = l.stable && near;
+    if (std::getenv("PP_TRACE_ROBUST"))
+      std::fprintf(stderr, "trial %d of %zu: stable %d at_rest %d moved %.1f mm turned %.1f deg path %zu\n", l.root % kTrials, i,
+                   l.stable, l.at_rest, 1000 * (c1 - c0).norm(), angleBetween(l.X_GO, X_GO[i]) * 180 / M_PI, l.path.size());
+    if (!held) state[l.root] = -1;
+    else if (state[l.root] == 0) state[l.root] = 1;
+    if (held) tip[l.root] = std::min(tip[l.root], l.tipping_angle);
+  }
+  for (int r : open) state[r] = -1;
+  std::vector<Robustness> out(X_GO.size());
+  for (size_t i = 0; i < X_GO.size(); ++i) {
+    Robustness& r = out[i];
+    r.trials = kTrials;
+    r.min_tipping_angle = kInf;
+    for (int k = 0; k < kTrials; ++k) {
+      const int s = state[i * kTrials + k];
+      r.held += s > 0;
+      if (s > 0) r.min_tipping_angle = std::min(r.min_tipping_angle, tip[i * kTrials + k]);
+    }
+    if (r.held == 0) r.min_tipping_angle = 0;
+  }
+  return out;
+}
+
+}  // namespace place_planner

@@ -1,0 +1,252 @@
+// The batched tree steps (tree_stepper.h): first contact, contact points with stability and
+// tilt axis, tilt angles. Every pending pose of every tree advances together.
+#include "place_planner/tree_stepper.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+
+#include "place_planner/contact_points.h"
+#include "place_planner/local_optimisation.h"
+#include "place_planner/parallel_for.h"
+#include "place_planner/tilt_axis.h"
+
+namespace place_planner {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// PP_TRACE=1 in the environment prints every tree node and rotation to stderr.
+const bool kTrace = std::getenv("PP_TRACE") != nullptr;
+constexpr double kSmallTurn = 2.0 * M_PI / 180.0;
+constexpr int kMaxTurnsPerRotation = 4;
+
+Rigid translated(Rigid X, const V3& d) {
+  X.t = X.t + d;
+  return X;
+}
+
+// A direction is blocked when a contact away from the axis would move into the area.
+bool blocked(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& s,
+             const Eigen::Vector3d& d, int sigma, double lever_tol) {
+  for (const auto& c : contacts) {
+    const Eigen::Vector3d r = c.p_W - s;
+    const Eigen::Vector3d v = sigma * d.cross(r);
+    if (v.norm() < lever_tol) continue;  // on the axis
+    if (v.normalized().dot(c.n_W) < -0.3) return true;
+  }
+  return false;
+}
+
+void addTime(double* slot, Clock::time_point t0) {
+  if (slot) *slot += msSince(t0);
+}
+
+}  // namespace
+
+Rigid rotatedAbout(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector3d& d, double angle) {
+  Eigen::Isometry3d Rot = Eigen::Isometry3d::Identity();
+  Rot.linear() = Eigen::AngleAxisd(angle, d.normalized()).toRotationMatrix();
+  Rot.translation() = s - Rot.linear() * s;
+  return toRigid(Rot * toIsometry(X));
+}
+
+TreeStepper::TreeStepper(const TreeContext& ctx) : ctx_(ctx), diag_(norm(ctx.am.bounds.hi - ctx.am.bounds.lo)) {}
+
+void TreeStepper::addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax) {
+  TreeNode n;
+  n.X_GO = X_GO;
+  n.root = root;
+  n.com_O = com_O;
+  n.path.push_back(X_GO);
+  n.pending.push_back(direction);
+  n.pending_tmax.push_back(tmax);
+  translate_.push_back(std::move(n));
+}
+
+std::vector<int> TreeStepper::openRoots() const {
+  std::vector<int> open;
+  for (const auto* list : {&translate_, &contact_, &rotating_})
+    for (const TreeNode& n : *list) open.push_back(n.root);
+  std::sort(open.begin(), open.end());
+  open.erase(std::unique(open.begin(), open.end()), open.end());
+  return open;
+}
+
+void TreeStepper::step(std::vector<TreeLeaf>& leaves) {
+  if (!translate_.empty()) firstContactStep();
+  if (!contact_.empty()) contactStep(leaves);
+  if (!rotating_.empty()) tiltStep();
+}
+
+// ---------------------------------------------------------------- first contact (V-A)
+// Exact translation along each pending direction until the object first touches the area.
+void TreeStepper::firstContactStep() {
+  const auto t0 = Clock::now();
+  std::vector<TranslationQuery> q;
+  for (const TreeNode& n : translate_) q.push_back({n.X_GO, n.pending.front(), n.pending_tmax.front()});
+  std::vector<double> t;
+  ctx_.backend.distance(q, t);
+  std::vector<TreeNode> again;
+  for (size_t i = 0; i < translate_.size(); ++i) {
+    TreeNode& n = translate_[i];
+    if (t[i] >= kInf) continue;  // nothing below: the object would fall off the area
+    n.X_GO = translated(n.X_GO, t[i] * n.pending.front());
+    n.path.push_back(n.X_GO);
+    n.pending.erase(n.pending.begin());
+    n.pending_tmax.erase(n.pending_tmax.begin());
+    (n.pending.empty() ? contact_ : again).push_back(std::move(n));
+  }
+  translate_.swap(again);
+  addTime(ctx_.times ? &ctx_.times->first_contact : nullptr, t0);
+}
+
+// ---------------------------------------------------------------- contact points (V-B),
+// stability (VI), tilt axis (V-C.1) and the tree's decision for each pose.
+void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
+  auto t0 = Clock::now();
+  std::vector<Rigid> X;
+  for (const TreeNode& n : contact_) X.push_back(n.X_GO);
+  std::vector<std::vector<SphereContact>> raw;
+  ctx_.backend.contactPoints(X, raw);
+  addTime(ctx_.times ? &ctx_.times->contact_points : nullptr, t0);
+  t0 = Clock::now();
+  if (ctx_.tree_nodes) *ctx_.tree_nodes += static_cast<long>(contact_.size());
+  const double cd = ctx_.cd;
+  // Contacts, stability and tilt axis of every node are independent: computed on the pool;
+  // the tree decisions below stay serial, in node order.
+  std::vector<Stability> stab(contact_.size());
+  std::vector<TiltAxis> axes(contact_.size());
+  parallelFor(contact_.size(), ctx_.threads, [&](size_t i) {
+    TreeNode& n = contact_[i];
+    n.contacts = reduceContacts(raw[i], cd);
+    const Eigen::Vector3d com = toEigen(apply(n.X_GO, n.com_O));
+    stab[i] = evaluateStability(n.contacts, com, ctx_.stability);
+    const Eigen::Vector3d k1 = toEigen(rotate(n.X_GO, toV3(ctx_.om.principal_axes.col(0))));
+    axes[i] = tiltAxis(n.contacts, com, k1, Eigen::Vector3d(0, 0, -1), 1.5 * cd, n.root + 7919u * n.depth);
+  });
+  for (size_t i = 0; i < contact_.size(); ++i) {
+    TreeNode& n = contact_[i];
+    const Eigen::Vector3d com = toEigen(apply(n.X_GO, n.com_O));
+    const Stability& s = stab[i];
+    const TiltAxis& axis = axes[i];
+    auto leaf = [&](bool stable, bool at_rest) {
+      leaves.push_back(TreeLeaf{n.X_GO, n.root, stable, at_rest, s.quality, s.tipping_angle, n.contacts, n.path});
+    };
+    if (kTrace)
+      std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d tip %.1f deg Q %.3f\n",
+                   n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable,
+                   s.tipping_angle * 180 / M_PI, s.quality);
+    if (n.contacts.empty()) continue;
+    // One contact never holds an object (a ball rolls): tilt (Section V-C) about it. Contacts
+    // along a line are a band of touching surface (a cylinder lying on its side, a marker on
+    // its barrel): they hold only when that band passes the stability test with its tipping
+    // margin (the pose is then neutral in roll at worst, and the robustness check releases it
+    // tilted); otherwise the object tilts about the line.
+    const bool line = axis.layout == ContactLayout::kSingle ||
+                      (axis.layout == ContactLayout::kCollinear && !s.stable);
+    const bool can_turn = n.depth < ctx_.max_rotations &&
+                          n.turns < kMaxTurnsPerRotation * std::max(1, ctx_.max_rotations);
+    if (line && can_turn) {
+      n.s_A = axis.s_A;
+      n.d_A = axis.d_A;
+      n.both_directions = true;
+      n.local_rotation = false;
+      rotating_.push_back(std::move(n));
+    } else if (line) {
+      leaf(false, false);  // still tilting when the tree was cut
+    } else if (s.stable) {
+      leaf(true, true);
+    } else if (n.opt < ctx_.max_opt) {
+      // Local optimisation (Section VI): slide down the slope, or tip into the failure direction.
+      const auto tl = Clock::now();
+      const LocalStep step = localOptimisationStep(s, com, cd);
+      addTime(ctx_.times ? &ctx_.times->local_optimisation : nullptr, tl);
+      if (step.kind == LocalStep::kSlide) {
+        ++n.opt;
+        n.X_GO = translated(n.X_GO, toV3(step.lift));
+        n.path.push_back(n.X_GO);
+        n.pending = {toV3(step.slide), v3(0, 0, -1)};
+        n.pending_tmax = {0.5 * diag_, diag_};
+        translate_.push_back(std::move(n));
+      } else if (step.kind == LocalStep::kRotate) {
+        ++n.opt;
+        n.s_A = step.s_A;
+        n.d_A = step.d_A;
+        n.both_directions = false;
+        n.local_rotation = true;
+        rotating_.push_back(std::move(n));
+      } else {
+        leaf(false, true);
+      }
+    } else {
+      leaf(false, true);
+    }
+  }
+  contact_.clear();
+  addTime(ctx_.times ? &ctx_.times->stability : nullptr, t0);
+}
+
+// ---------------------------------------------------------------- tilt angles (V-C.2)
+// Exact angles to the next contact, vertex/surface and edge/edge, in both directions.
+void TreeStepper::tiltStep() {
+  std::vector<RotationQuery> q;
+  for (const TreeNode& n : rotating_) {
+    RotationQuery rq{n.X_GO, toV3(n.s_A), toV3(n.d_A)};
+    // Of the tree's two branches only those that lower the centre of mass are followed:
+    // gravity cannot tip a free object the other way, and the cut keeps the tree linear in
+    // the number of rotations instead of exponential.
+    const Eigen::Vector3d c = toEigen(apply(n.X_GO, n.com_O));
+    const double dz = n.d_A.cross(c - n.s_A).z();  // d(com.z)/d(angle) for +rotation
+    const double lever = (c - n.s_A).norm();
+    if (!n.local_rotation && dz > 1e-3 * lever) rq.limit_ccw = 0;
+    if (!n.local_rotation && dz < -1e-3 * lever) rq.limit_cw = 0;
+    // Directions a contact blocks, or not asked for, are not searched (limit 0).
+    if (blocked(n.contacts, n.s_A, n.d_A, 1, 1.5 * ctx_.cd)) rq.limit_ccw = 0;
+    if (!n.both_directions || blocked(n.contacts, n.s_A, n.d_A, -1, 1.5 * ctx_.cd)) rq.limit_cw = 0;
+    q.push_back(rq);
+  }
+  std::vector<AnglePair> av, ae;
+  auto t0 = Clock::now();
+  ctx_.backend.vertexSurfaceRotation(q, av);
+  addTime(ctx_.times ? &ctx_.times->tilt_vertex : nullptr, t0);
+  // Edge/edge only has to beat the vertex/surface angle. Where no vertex meets a patch over
+  // the whole tilt range, the object turns off the area: no edge/edge search.
+  for (size_t i = 0; i < q.size(); ++i) {
+    q[i].limit_ccw = av[i].ccw >= kInf ? 0.0 : std::min(q[i].limit_ccw, av[i].ccw);
+    q[i].limit_cw = av[i].cw >= kInf ? 0.0 : std::min(q[i].limit_cw, av[i].cw);
+  }
+  t0 = Clock::now();
+  ctx_.backend.edgeEdgeRotation(q, ae);
+  addTime(ctx_.times ? &ctx_.times->tilt_edge : nullptr, t0);
+  for (size_t i = 0; i < rotating_.size(); ++i) {
+    const TreeNode& n = rotating_[i];
+    for (int sigma : {1, -1}) {
+      if (sigma < 0 && !n.both_directions) continue;
+      const double a = sigma > 0 ? std::min(av[i].ccw, ae[i].ccw) : std::min(av[i].cw, ae[i].cw);
+      if (kTrace)
+        std::fprintf(stderr, "root %d depth %d sigma %d angle %.2f deg\n", n.root, n.depth, sigma, a * 180 / M_PI);
+      if (a >= kInf) continue;  // blocked, or turns freely: no resting pose that way
+      TreeNode c;
+      c.X_GO = rotatedAbout(n.X_GO, n.s_A, n.d_A, sigma * a);
+      c.root = n.root;
+      c.com_O = n.com_O;
+      // Rolling over the facets of a curved surface takes many small turns; only turns of a
+      // few degrees count against max_rotations (all of them against a hard cap).
+      c.depth = n.depth + (n.local_rotation || a < kSmallTurn ? 0 : 1);
+      c.turns = n.turns + 1;
+      c.opt = n.opt;
+      c.path = n.path;
+      c.path.push_back(c.X_GO);
+      contact_.push_back(std::move(c));
+    }
+  }
+  rotating_.clear();
+}
+
+}  // namespace place_planner

@@ -173,7 +173,24 @@ std::vector<RestingFace> restingFaces(const Mesh& object, double min_tipping_ang
       }
     }
     if (nsum.norm() <= 0) continue;
-    const Eigen::Vector3d nrm = nsum.normalized();
+    // The object rests on one hull triangle of the facet: the one the centre of mass projects
+    // into along its own normal (a scanned base is not quite flat); else the mean plane.
+    Eigen::Vector3d nrm = nsum.normalized();
+    for (int fi : members) {
+      const auto& t = hull.faces[fi];
+      const Eigen::Vector3d& nf = hull.normals[fi];
+      const Eigen::Vector3d q = com - (com - hull.points[t[0]]).dot(nf) * nf;
+      bool inside = true;
+      for (int k = 0; k < 3 && inside; ++k) {
+        const Eigen::Vector3d& a = hull.points[t[k]];
+        const Eigen::Vector3d& b = hull.points[t[(k + 1) % 3]];
+        inside = (b - a).cross(q - a).dot(nf) >= 0;
+      }
+      if (inside) {
+        nrm = nf;
+        break;
+      }
+    }
     // Support polygon on the facet's outermost plane; the centre of mass projected along nrm.
     double plane = -1e300;
     for (int fi : members)

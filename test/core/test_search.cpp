@@ -1,0 +1,227 @@
+// Issue 9: the orientation search (resting faces, full tilt range), robust stability and
+// stability against gravity. Each test asserts that work was done before the property.
+#include <Eigen/Geometry>
+#include <map>
+
+#include "place_planner/backend.h"
+#include "place_planner/mesh_io.h"
+#include "place_planner/planner.h"
+#include "place_planner/resting_faces.h"
+#include "place_planner/robustness.h"
+#include "place_planner/stability.h"
+#include "test_helpers.h"
+
+using namespace place_planner;
+
+namespace {
+
+// Icosphere (subdivided icosahedron), outward wound: a ball.
+Mesh icosphere(double radius, int subdivisions) {
+  const double t = (1 + std::sqrt(5.0)) / 2;
+  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (auto& p : v) p.normalize();
+  for (int s = 0; s < subdivisions; ++s) {
+    std::map<std::pair<int, int>, int> mid;
+    auto midpoint = [&](int a, int b) {
+      auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back((v[a] + v[b]).normalized());
+      return mid[key] = static_cast<int>(v.size()) - 1;
+    };
+    std::vector<std::array<int, 3>> g;
+    for (const auto& tr : f) {
+      const int a = midpoint(tr[0], tr[1]), b = midpoint(tr[1], tr[2]), c = midpoint(tr[2], tr[0]);
+      g.push_back({tr[0], a, c});
+      g.push_back({tr[1], b, a});
+      g.push_back({tr[2], c, b});
+      g.push_back({a, b, c});
+    }
+    f = g;
+  }
+  for (auto& p : v) p *= radius;
+  std::vector<std::vector<int>> polys;
+  for (const auto& tr : f) polys.push_back({tr[0], tr[1], tr[2]});
+  return buildMesh(v, polys, "ball");
+}
+
+double minZ(const Mesh& m, const Candidate& c) {
+  double z = 1e9;
+  for (const auto& v : m.vertices) z = std::min(z, (c.X_WO * v).z());
+  return z;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ resting faces (IV-A)
+TEST(RestingFaces, BoxHasSix) {
+  const auto faces = restingFaces(scenes::box(0.1, 0.06, 0.03), 10 * M_PI / 180);
+  ASSERT_EQ(faces.size(), 6u);
+  // Best margin first: lying on a 10 x 6 face (tipping about its short half-width 3 cm over a
+  // 1.5 cm height) before standing on the 6 x 3 end.
+  EXPECT_GT(std::abs(faces.front().normal_O.z()), 0.999);
+  EXPECT_NEAR(faces.front().tipping_angle, std::atan2(0.03, 0.015), 1e-6);
+  for (size_t i = 1; i < faces.size(); ++i) EXPECT_LE(faces[i].tipping_angle, faces[i - 1].tipping_angle);
+}
+
+TEST(RestingFaces, BallHasNone) {
+  const Mesh ball = icosphere(0.04, 3);
+  ASSERT_GT(convexHull3d(ball.vertices).faces.size(), 1000u);
+  EXPECT_TRUE(restingFaces(ball, 10 * M_PI / 180).empty());
+  // With no margin asked for, the facets are there: the filter is what removes them.
+  EXPECT_FALSE(restingFaces(ball, 0.0).empty());
+}
+
+TEST(RestingFaces, MugIncludesUprightAndRimDown) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const auto faces = restingFaces(mug, 10 * M_PI / 180);
+  bool upright = false, rim_down = false;
+  for (const auto& f : faces) {
+    upright |= f.normal_O.z() < -0.99;  // base facet's outward normal points down
+    rim_down |= f.normal_O.z() > 0.99;
+  }
+  EXPECT_TRUE(upright);
+  EXPECT_TRUE(rim_down);
+}
+
+// ------------------------------------------------------------------ the search
+TEST(Search, MarkerReleasedOnItsEnds) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh marker = loadMesh(test::sharedData() + "/objects/marker_ycb040_1k.ply");
+  const Mesh table = loadMesh(test::sharedData() + "/areas/table.ply");
+  const Eigen::Vector3d ext = marker.properties.bounds_max - marker.properties.bounds_min;
+  ASSERT_NEAR(ext.maxCoeff(), 0.12, 0.02) << "a 12 cm marker";
+  PlannerConfig cfg;
+  cfg.orientation = OrientationMode::kKeep;
+  int standing_ends = 0;
+  // Released standing on each end: k1 (its long axis) along gravity.
+  for (double s : {1.0, -1.0}) {
+    cfg.start_orientation = Eigen::Quaterniond::FromTwoVectors(s * marker.properties.k1(), Eigen::Vector3d::UnitZ());
+    const PlanResult r = Planner().plan(marker, table, cfg);
+    EXPECT_GT(r.stats.tree_nodes, r.stats.floor_points_total) << "end " << s;
+    bool stands = false;
+    for (const auto& c : r.candidates) {
+      if (!c.stable) continue;
+      const Eigen::Vector3d k1 = c.X_WO.linear() * marker.properties.k1();
+      stands |= std::abs(k1.z()) > 0.9;
+      // Whatever is claimed stable rests on the table and held every perturbed release.
+      EXPECT_NEAR(minZ(marker, c), 0.0, 0.003);
+      EXPECT_EQ(c.robustness.held, c.robustness.trials);
+      EXPECT_GE(c.robustness.min_tipping_angle, 3 * M_PI / 180);
+    }
+    standing_ends += stands;
+    // Trees that tip it over and cannot settle within max_rotations are counted.
+    if (r.stableCount() == 0) EXPECT_GT(r.stats.trees_without_rest, 0);
+  }
+  // It stands on its flat cap, not on its conical tip.
+  EXPECT_EQ(standing_ends, 1);
+}
+
+TEST(Search, MugOnTableWithDefaultsStandsOnItsBase) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh table = loadMesh(test::sharedData() + "/areas/table.ply");
+  const PlanResult r = Planner().plan(mug, table, PlannerConfig());
+  ASSERT_FALSE(r.candidates.empty());
+  const Candidate& best = r.candidates.front();
+  ASSERT_TRUE(best.stable);
+  EXPECT_GE(best.quality, 0.9);
+  // The held orientation (identity: the mug upright in its frame) breaks the tie of the two
+  // flat faces: upright first.
+  const Eigen::Vector3d axis = best.X_WO.linear() * Eigen::Vector3d::UnitZ();
+  EXPECT_GT(axis.z(), 0.99) << "best is not upright";
+  EXPECT_NEAR(minZ(mug, best), 0.0, 0.003);
+  EXPECT_GT(best.robustness.trials, 0);
+  // Held upside down, the least re-orientation puts it rim down.
+  PlannerConfig cfg;
+  cfg.start_orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+  const PlanResult flipped = Planner().plan(mug, table, cfg);
+  ASSERT_FALSE(flipped.candidates.empty());
+  ASSERT_TRUE(flipped.candidates.front().stable);
+  EXPECT_LT((flipped.candidates.front().X_WO.linear() * Eigen::Vector3d::UnitZ()).z(), -0.99);
+}
+
+TEST(Search, BallHasNoStableCandidate) {
+  const Mesh ball = icosphere(0.04, 3);
+  PlannerConfig cfg;
+  cfg.floor_point_spacing = 0.2;
+  const PlanResult r = Planner().plan(ball, scenes::table(), cfg);
+  EXPECT_GT(r.stats.tree_nodes, 10);
+  ASSERT_FALSE(r.candidates.empty()) << "no leaf reached";
+  EXPECT_EQ(r.stableCount(), 0);
+  EXPECT_EQ(r.outcome(), PlanOutcome::kNoStable);
+}
+
+TEST(Search, ApproachAgainstGravityFindsNothingBelowTheTable) {
+  const Mesh cube = scenes::box(0.05, 0.05, 0.05);
+  const Mesh table = scenes::table();
+  PlannerConfig cfg;
+  cfg.approach = Eigen::Vector3d(0, 0, 1);
+  cfg.floor_point_spacing = 0.2;
+  cfg.robust_check = false;  // stability against gravity alone must decide
+  const PlanResult r = Planner().plan(cube, table, cfg);
+  EXPECT_GT(r.stats.tree_nodes, 0);
+  const double top = table.properties.bounds_max.z();
+  for (const auto& c : r.candidates)
+    if (c.stable) EXPECT_GT((c.X_WO * cube.properties.center_of_mass).z(), top) << "stable under the table";
+}
+
+// ------------------------------------------------------------------ robust stability
+// A 6 x 6 x 3 cm box on a 1 cm wide wall top, its centre of mass 2 mm inside the wall's edge.
+TEST(Robustness, BoxNearTheEdgeOfAWallTop) {
+  const Mesh box = scenes::box(0.06, 0.06, 0.03);  // centred on its origin
+  const Mesh wall = scenes::box(0.01, 0.3, 0.1, {0, 0, -0.05});  // top at z = 0, x in +-5 mm
+  const double r = 0.0005, r_area = 0.00075, cd = r + r_area;
+  const ObjectModel om = buildObjectModel(box, r);
+  const AreaModel am = buildAreaModel(wall, Eigen::Vector3d(0, 0, -1), r_area, cd, cd);
+  auto backend = makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2);
+  const TreeContext ctx{om, am, *backend, StabilityParams{0.5, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2};
+  // Centre of mass at x = 3 mm: 2 mm inside the wall's edge at x = 5 mm; resting on the top.
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(0.003, 0, 0.015);
+  const Rigid X_GO = toRigid(X);
+  RobustnessParams p;
+  p.shift = 0;
+  p.tilt = 0;
+  p.com_offset = 0;
+  const Robustness exact = checkRobustness({X_GO}, ctx, p).front();
+  EXPECT_EQ(exact.trials, 12);
+  EXPECT_EQ(exact.held, 12) << "stable at delta = 0";
+  p.shift = 0.003;
+  const Robustness shifted = checkRobustness({X_GO}, ctx, p).front();
+  EXPECT_LT(shifted.held, 12) << "a 3 mm shift over the edge must fall";
+  // The shifts along the wall (y) and away from the edge (-x) hold.
+  EXPECT_GE(shifted.held, 11);
+}
+
+TEST(Stability, WedgeNeedsSqueezeAndIsNotStable) {
+  // A body held only by two vertical walls (normals +-x), nothing below: gravity needs
+  // friction forces that come only from squeeze (at least weight / mu in total).
+  const std::vector<ContactPoint> wedge = {{{-0.02, 0, 0}, {1, 0, 0}}, {{0.02, 0, 0}, {-1, 0, 0}},
+                                           {{-0.02, 0.01, 0}, {1, 0, 0}}, {{0.02, 0.01, 0}, {-1, 0, 0}}};
+  const Eigen::Vector3d com(0, 0.005, 0);
+  EXPECT_FALSE(equilibrium(wedge, com, Eigen::Vector3d(0, 0, -1), 0.2, 0.02));
+  // With unbounded squeeze the same contacts balance gravity: the bound is what rejects it.
+  EXPECT_TRUE(equilibrium(wedge, com, Eigen::Vector3d(0, 0, -1), 0.2, 0.02, 1e6));
+  // A floor loads its contacts with the weight alone.
+  const std::vector<ContactPoint> floor = {{{-0.02, -0.02, 0}, {0, 0, 1}}, {{0.02, -0.02, 0}, {0, 0, 1}},
+                                           {{0, 0.02, 0}, {0, 0, 1}}};
+  EXPECT_TRUE(equilibrium(floor, Eigen::Vector3d(0, 0, 0.01), Eigen::Vector3d(0, 0, -1), 0.2, 0.02));
+}
+
+TEST(Stability, ContactsFromAboveNeverHold) {
+  // The cube under a table top: contacts on its top face, normals pointing down at it.
+  std::vector<ContactPoint> c;
+  for (double x : {-0.02, 0.02})
+    for (double y : {-0.02, 0.02}) c.push_back({{x, y, 0.05}, {0, 0, -1}});
+  const Stability s = evaluateStability(c, Eigen::Vector3d(0, 0, 0.025), StabilityParams{});
+  EXPECT_FALSE(s.stable);
+  for (auto& p : c) p.n_W = Eigen::Vector3d(0, 0, 1);  // the same contacts from below hold
+  EXPECT_TRUE(evaluateStability(c, Eigen::Vector3d(0, 0, 0.075), StabilityParams{}).stable);
+}

@@ -10,7 +10,9 @@ add_library(place_planner_ros STATIC
   src/node/place_planner_node.cpp)
 target_include_directories(place_planner_ros PUBLIC
   ${PROJECT_SOURCE_DIR}/include ${CATKIN_DEVEL_PREFIX}/include ${catkin_INCLUDE_DIRS})
-target_link_libraries(place_planner_ros PUBLIC place_planner_core ${catkin_LIBRARIES})
+# place_planner_validation (cmake/validation.cmake, defined after this file): verify_top_k.
+target_link_libraries(place_planner_ros PUBLIC place_planner_validation place_planner_core
+                      ${catkin_LIBRARIES})
 target_compile_options(place_planner_ros PRIVATE ${PP_WARN})
 add_dependencies(place_planner_ros ${${PROJECT_NAME}_EXPORTED_TARGETS} ${catkin_EXPORTED_TARGETS})
 
@@ -37,4 +39,11 @@ if(CATKIN_ENABLE_TESTING)
   # The test starts the node itself once, with a bad parameter, to see it refuse.
   target_compile_definitions(place_planner_node_test PRIVATE
     PP_NODE_BINARY="$<TARGET_FILE:place_planner_node>")
+
+  # The command-line tool's exit codes and outcome line (no ROS master needed): it runs the
+  # built binary.
+  catkin_add_gtest(cli_tests test/ros/test_cli.cpp)
+  target_link_libraries(cli_tests place_planner_core)
+  add_dependencies(cli_tests place_planner_cli)
+  target_compile_definitions(cli_tests PRIVATE PP_CLI_BINARY="$<TARGET_FILE:place_planner_cli>")
 endif()

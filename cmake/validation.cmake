@@ -34,3 +34,9 @@ if(CATKIN_ENABLE_TESTING)
     PP_SOURCE_DIR="${PP_VALIDATION_REAL_SOURCE_DIR}"
     PP_SHARED_DATA_DIR="${PP_VALIDATION_REAL_SOURCE_DIR}/../shared/data")
 endif()
+
+# ---------------------------------------------------------------- physics check in the product
+# place_planner_cli --verify K (validation::verifyTopK); the node links it through
+# place_planner_ros (cmake/node.cmake).
+target_link_libraries(place_planner_cli place_planner_validation)
+target_compile_definitions(place_planner_cli PRIVATE PLACE_PLANNER_HAVE_VALIDATION=1)

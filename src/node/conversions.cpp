@@ -151,6 +151,14 @@ void toMsg(const Candidate& c, const std::string& frame_id, const ros::Time& sta
         &msg->gripper_pose.pose);
   msg->quality = c.quality;
   msg->stable = c.stable;
+  msg->robust_share = c.robustness.share();
+  msg->robust_trials = c.robustness.trials;
+  msg->min_tipping_angle = c.robustness.min_tipping_angle;
+  msg->start = toString(c.start);
+  msg->physics_checked = c.physics.checked;
+  msg->physics_stayed = c.physics.stayed;
+  msg->physics_moved = c.physics.moved_m;
+  msg->physics_turned = c.physics.turned_deg;
   msg->contact_points.resize(c.contacts.size());
   msg->contact_normals.resize(c.contacts.size());
   for (size_t i = 0; i < c.contacts.size(); ++i) {

@@ -27,6 +27,13 @@ class ParamReader {
     *value = static_cast<int>(v);
   }
 
+  void read(const std::string& key, bool* value) const {
+    XmlRpc::XmlRpcValue v;
+    if (!nh_.getParam(key, v)) return;
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) fail(key, "must be true or false");
+    *value = static_cast<bool>(v);
+  }
+
   void read(const std::string& key, std::string* value) const {
     XmlRpc::XmlRpcValue v;
     if (!nh_.getParam(key, v)) return;
@@ -82,6 +89,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("feedback_period", &c.feedback_period);
   r.read("marker_candidates", &c.marker_candidates);
   r.read("marker_text_count", &c.marker_text_count);
+  r.read("verify_top_k", &c.verify_top_k);
   if (c.planning_frame.empty()) r.fail("planning_frame", "must not be empty");
   if (!(c.tf_timeout >= 0 && c.tf_timeout <= 60)) r.fail("tf_timeout", "is out of range (0 .. 60 s)");
   if (!(c.feedback_period > 0 && c.feedback_period <= 0.1)) {
@@ -89,6 +97,9 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   }
   if (c.marker_candidates < 0) r.fail("marker_candidates", "is out of range (>= 0)");
   if (c.marker_text_count < 0) r.fail("marker_text_count", "is out of range (>= 0)");
+  if (c.verify_top_k < 0 || c.verify_top_k > 100) {
+    r.fail("verify_top_k", "is out of range (0 .. 100, 0 = off)");
+  }
 
   // PlannerConfig, field for field (include/place_planner/config.h).
   PlannerConfig& p = c.planner;
@@ -103,6 +114,12 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("grid_cell_size", &p.grid_cell_size);
   std::string orientation = toString(p.orientation);
   r.read("orientation", &orientation);
+  r.read("max_resting_faces", &p.max_resting_faces);
+  r.read("robust_shift", &p.robust_shift);
+  r.read("robust_tilt_deg", &p.robust_tilt_deg);
+  r.read("robust_com_offset", &p.robust_com_offset);
+  r.read("robust_min_share", &p.robust_min_share);
+  r.read("robust_check", &p.robust_check);
   r.read("time_budget_ms", &p.time_budget_ms);
   r.read("max_candidates", &p.max_candidates);
   r.read("threads", &p.threads);

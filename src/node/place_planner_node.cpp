@@ -11,6 +11,7 @@
 
 #include "place_planner/ros/conversions.h"
 #include "place_planner/ros/markers.h"
+#include "place_planner/validation/physics_validator.h"
 
 namespace place_planner {
 namespace {
@@ -72,6 +73,7 @@ struct PlacePlannerNode::Prepared {
   Mesh object_O;  // in the object's mesh frame O
   Mesh area_W;    // in the planning frame
   PlannerConfig config;
+  int verify_top_k = 0;  // Bullet check of the best K stable candidates (0 = off)
   bool has_grasp = false;
   Eigen::Isometry3d X_OG = Eigen::Isometry3d::Identity();
 };
@@ -180,6 +182,11 @@ PlacePlannerNode::Prepared PlacePlannerNode::prepare(const PlacePlanGoal& goal) 
   if (goal.max_candidates != 0) c.max_candidates = goal.max_candidates;
   if (goal.min_quality != 0) c.min_quality = goal.min_quality;
   if (goal.time_budget != 0) c.time_budget_ms = goal.time_budget * 1000.0;
+  out.verify_top_k = goal.verify_top_k == 0 ? config_.verify_top_k : std::max(0, goal.verify_top_k);
+  if (out.verify_top_k > 100) {
+    throw GoalError(Result::INVALID_GOAL, "goal: verify_top_k = " + std::to_string(goal.verify_top_k) +
+                                              " is out of range (<= 100; 0 = parameter, < 0 = off)");
+  }
   try {
     if (!goal.orientation_mode.empty()) c.orientation = orientationModeFromString(goal.orientation_mode);
     validate(c);  // names the field: "friction = -1 is out of range (...)"
@@ -260,6 +267,26 @@ void PlacePlannerNode::execute(const PlacePlanGoalConstPtr& goal) {
   }
   for (const auto& w : plan.warnings) ROS_WARN("place_planner: %s", w.c_str());
 
+  // Physics check of the best K stable candidates, in what is left of the budget; not for a
+  // cancelled goal, and a cancel stops it starting further checks.
+  std::string physics_summary;
+  if (prepared.verify_top_k > 0 && !plan.cancelled && plan.stableCount() > 0) {
+    try {
+      const validation::VerifyStats v = validation::verifyTopK(
+          prepared.object_O, prepared.area_W, prepared.config, plan, prepared.verify_top_k,
+          validation::remainingBudgetMs(prepared.config.time_budget_ms, plan.stats.total_ms),
+          prepared.config.threads, [this] { return ros::ok() && !server_->isPreemptRequested(); });
+      std::ostringstream os;
+      os << "; physics: " << v.stayed << " of " << v.checked << " checked stayed ("
+         << v.selected - v.checked << " not checked, " << v.total_ms << " ms)";
+      physics_summary = os.str();
+    } catch (const std::exception& e) {
+      // The plan stands; the candidates stay unchecked.
+      ROS_ERROR("place_planner: physics check failed: %s", e.what());
+      physics_summary = std::string("; physics check failed: ") + e.what();
+    }
+  }
+
   const ros::Time stamp = ros::Time::now();
   result.candidates.resize(plan.candidates.size());
   for (size_t i = 0; i < plan.candidates.size(); ++i) {
@@ -268,30 +295,47 @@ void PlacePlannerNode::execute(const PlacePlanGoalConstPtr& goal) {
   }
   result.floor_points_evaluated = plan.stats.floor_points_done;
   result.planning_time = (ros::WallTime::now() - start).toSec();
-  const bool any_stable = std::any_of(plan.candidates.begin(), plan.candidates.end(),
-                                      [](const Candidate& c) { return c.stable; });
+  result.partial = false;
+  const int n_stable = plan.stableCount();
   std::ostringstream summary;
-  summary << plan.candidates.size() << " candidates from " << plan.stats.floor_points_done << " of "
-          << plan.stats.floor_points_total << " floor points in " << result.planning_time << " s";
-  if (plan.cancelled) {
-    result.error_code = Result::PREEMPTED;
-    result.error_message = "preempted: " + summary.str();
-    server_->setPreempted(result, result.error_message);
-  } else if (plan.timed_out) {
-    result.error_code = Result::TIMED_OUT;
-    result.error_message = "time budget of " + std::to_string(prepared.config.time_budget_ms / 1000.0) +
-                           " s used up: " + summary.str();
-    server_->setAborted(result, result.error_message);
-  } else if (!any_stable) {
-    result.error_code = Result::NO_STABLE_POSE;
-    result.error_message = "no stable pose: " + summary.str();
-    server_->setAborted(result, result.error_message);
-  } else {
-    result.error_code = Result::SUCCESS;
-    result.error_message = "";
-    server_->setSucceeded(result, summary.str());
+  summary << plan.candidates.size() << " candidates (" << n_stable << " stable) from "
+          << plan.stats.floor_points_done << " of " << plan.stats.floor_points_total
+          << " floor points in " << result.planning_time << " s" << physics_summary;
+  const std::string budget =
+      "time budget of " + std::to_string(prepared.config.time_budget_ms / 1000.0) + " s used up";
+  // PlanResult::outcome() decides; the codes keep their numbers.
+  switch (plan.outcome()) {
+    case PlanOutcome::kCancelled:
+      result.error_code = Result::PREEMPTED;
+      result.error_message = "preempted: " + summary.str();
+      server_->setPreempted(result, result.error_message);
+      break;
+    case PlanOutcome::kTimedOutWithStable:
+      // A partial answer is still an answer: SUCCESS, flagged.
+      result.error_code = Result::SUCCESS;
+      result.partial = true;
+      result.error_message = "partial answer: " + budget + ", the stable candidates found so far: " +
+                             summary.str();
+      server_->setSucceeded(result, result.error_message);
+      break;
+    case PlanOutcome::kTimedOutNone:
+      result.error_code = Result::TIMED_OUT;
+      result.error_message = budget + " before any stable pose: " + summary.str();
+      server_->setAborted(result, result.error_message);
+      break;
+    case PlanOutcome::kNoStable:
+      result.error_code = Result::NO_STABLE_POSE;
+      result.error_message = "no stable pose: " + summary.str();
+      server_->setAborted(result, result.error_message);
+      break;
+    case PlanOutcome::kStable:
+      result.error_code = Result::SUCCESS;
+      result.error_message = "";
+      server_->setSucceeded(result, summary.str());
+      break;
   }
-  ROS_INFO("place_planner: %s, %s", codeName(result.error_code), summary.str().c_str());
+  ROS_INFO("place_planner: %s%s, %s", codeName(result.error_code), result.partial ? " (partial)" : "",
+           summary.str().c_str());
 
   // Visualisation after the answer, so it does not delay the caller.
   MarkerOptions options;

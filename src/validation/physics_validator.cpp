@@ -11,9 +11,12 @@
 #include <map>
 #include <queue>
 #include <sstream>
+#include <unordered_map>
 #include <stdexcept>
 #include <utility>
 #include <vector>
+
+#include "place_planner/parallel_for.h"
 
 namespace place_planner {
 namespace validation {
@@ -76,12 +79,64 @@ void validateConfig(const ValidatorConfig& c) {
   require(c.max_drop_time > 0, "max_drop_time", c.max_drop_time, "must be > 0");
 }
 
-// Distance along unit d from p to the nearest triangle not in `skip` (Moller-Trumbore);
-// infinity when the ray leaves the mesh (open meshes).
+// Triangles binned by their bounding boxes into cubic cells of size h: a segment no longer than
+// h meets only triangles listed in the (at most 2 x 2 x 2) cells its own box touches. It makes
+// the thickness rays of makeConvexPieces local: 16 s -> well under 1 s for a 16k-triangle mug.
+class TriangleGrid {
+ public:
+  TriangleGrid(const Mesh& m, double h) : h_(h), stamp_(m.triangles.size(), 0) {
+    for (int t = 0; t < static_cast<int>(m.triangles.size()); ++t) {
+      Eigen::Vector3d lo = m.vertices[m.triangles[t][0]], hi = lo;
+      for (int k = 1; k < 3; ++k) {
+        lo = lo.cwiseMin(m.vertices[m.triangles[t][k]]);
+        hi = hi.cwiseMax(m.vertices[m.triangles[t][k]]);
+      }
+      forCells(lo, hi, [&](long long key) { cells_[key].push_back(t); });
+    }
+  }
+
+  // Triangles whose boxes may meet the segment a-b (|a - b| <= h), each once.
+  const std::vector<int>& near(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    ++round_;
+    out_.clear();
+    forCells(a.cwiseMin(b), a.cwiseMax(b), [&](long long key) {
+      const auto it = cells_.find(key);
+      if (it == cells_.end()) return;
+      for (int t : it->second) {
+        if (stamp_[t] == round_) continue;
+        stamp_[t] = round_;
+        out_.push_back(t);
+      }
+    });
+    return out_;
+  }
+
+ private:
+  template <typename F>
+  void forCells(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, F&& f) const {
+    const Eigen::Vector3i a = (lo / h_).array().floor().cast<int>();
+    const Eigen::Vector3i b = (hi / h_).array().floor().cast<int>();
+    for (int x = a.x(); x <= b.x(); ++x)
+      for (int y = a.y(); y <= b.y(); ++y)
+        for (int z = a.z(); z <= b.z(); ++z)
+          f((static_cast<long long>(x & 0x1fffff) << 42) | (static_cast<long long>(y & 0x1fffff) << 21) |
+            static_cast<long long>(z & 0x1fffff));
+  }
+
+  double h_;
+  std::unordered_map<long long, std::vector<int>> cells_;
+  std::vector<unsigned> stamp_;
+  unsigned round_ = 0;
+  std::vector<int> out_;
+};
+
+// Distance along unit d from p to the nearest of the triangles `candidates` not in `skip`
+// (Moller-Trumbore); infinity when the ray meets none of them (open meshes, or beyond the
+// candidates' reach).
 double rayDepth(const Mesh& m, const Eigen::Vector3d& p, const Eigen::Vector3d& d,
-                const std::vector<int>& skip) {
+                const std::vector<int>& candidates, const std::vector<int>& skip) {
   double best = std::numeric_limits<double>::infinity();
-  for (int t = 0; t < static_cast<int>(m.triangles.size()); ++t) {
+  for (int t : candidates) {
     if (std::find(skip.begin(), skip.end(), t) != skip.end()) continue;
     const Eigen::Vector3d& a = m.vertices[m.triangles[t][0]];
     const Eigen::Vector3d e1 = m.vertices[m.triangles[t][1]] - a;
@@ -120,6 +175,9 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
     centroid[t] = (a + b + d) / 3.0;
   }
   const std::vector<std::vector<int>> nbr = triangleNeighbours(m);
+  // The thickness is clamped to piece_thickness below: only triangles within that reach matter.
+  const double reach = std::max(c.piece_thickness, 6.0 * c.margin);
+  TriangleGrid grid(m, reach);
 
   const double cos_max = std::cos(c.piece_max_normal_deg * M_PI / 180.0);
   std::vector<char> used(nt, 0);
@@ -152,7 +210,8 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
     for (int t : group)
       for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d& p = m.vertices[m.triangles[t][k]];
-        depth = std::min(depth, rayDepth(m, p - 1e-6 * n, -n, group));
+        const Eigen::Vector3d start = p - 1e-6 * n;
+        depth = std::min(depth, rayDepth(m, start, -n, grid.near(start, start - reach * n), group));
       }
     const double thickness = std::clamp(depth, 6.0 * c.margin, c.piece_thickness);
     std::vector<Eigen::Vector3d> pts;
@@ -354,6 +413,11 @@ double PhysicsValidator::shapeBuildMs() const { return impl_->build_ms; }
 double PhysicsValidator::convexity() const { return impl_->convexity; }
 
 PoseCheck PhysicsValidator::check(const Eigen::Isometry3d& X_WO_goal) const {
+  return check(X_WO_goal, std::function<bool()>());
+}
+
+PoseCheck PhysicsValidator::check(const Eigen::Isometry3d& X_WO_goal,
+                                  const std::function<bool()>& keep_going) const {
   const auto t0 = Clock::now();
   const Impl& d = *impl_;
   const ValidatorConfig& c = d.cfg;
@@ -381,6 +445,10 @@ PoseCheck PhysicsValidator::check(const Eigen::Isometry3d& X_WO_goal) const {
       }
     }
     if ((i & 15) == 15) {  // early abort, checked every 16 steps
+      if (keep_going && !keep_going()) {
+        r.interrupted = true;
+        break;
+      }
       const Eigen::Isometry3d X = d.objectPose(*sim->body);
       if ((X * d.c_O - p_goal).norm() > c.abort_translation ||
           rotationAngleDeg(X.linear(), X_WO_goal.linear()) > c.abort_rotation_deg) {
@@ -392,7 +460,7 @@ PoseCheck PhysicsValidator::check(const Eigen::Isometry3d& X_WO_goal) const {
   r.X_WO_final = d.objectPose(*sim->body);
   r.moved_m = (r.X_WO_final * d.c_O - p_goal).norm();
   r.turned_deg = rotationAngleDeg(r.X_WO_final.linear(), X_WO_goal.linear());
-  r.confirmed = !r.aborted && (r.early_accepted || (r.moved_m < c.max_translation &&
+  r.confirmed = !r.aborted && !r.interrupted && (r.early_accepted || (r.moved_m < c.max_translation &&
                                                     r.turned_deg < c.max_rotation_deg));
   r.wall_ms = msSince(t0);
   return r;
@@ -428,6 +496,78 @@ DropResult PhysicsValidator::drop(const Eigen::Isometry3d& X_WO_start) const {
   r.X_WO_rest = d.objectPose(*sim->body);
   r.wall_ms = msSince(t0);
   return r;
+}
+
+double remainingBudgetMs(double plan_budget_ms, double used_ms) {
+  if (!(plan_budget_ms > 0)) return 0.0;
+  // 1 ns: spent, yet positive (0 would mean no limit).
+  return std::max(plan_budget_ms - used_ms, 1e-6);
+}
+
+VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerConfig& cfg,
+                       PlanResult& result, int k, double budget_ms, int threads,
+                       const std::function<bool()>& keep_going) {
+  const auto t0 = Clock::now();
+  VerifyStats s;
+  std::vector<Candidate>& cands = result.candidates;
+  for (Candidate& c : cands) c.physics = PhysicsCheck();
+  // The best k stable candidates, in rank order.
+  std::vector<size_t> picked;
+  for (size_t i = 0; i < cands.size() && static_cast<int>(picked.size()) < k; ++i)
+    if (cands[i].stable) picked.push_back(i);
+  s.selected = static_cast<int>(picked.size());
+  s.threads = std::max(1, std::min<int>(resolveThreads(threads), s.selected));
+  const bool limited = budget_ms > 0;
+  const std::function<bool()> may_start = [&] {
+    return !(limited && msSince(t0) >= budget_ms) && (!keep_going || keep_going());
+  };
+  if (picked.empty() || !may_start()) {
+    s.total_ms = msSince(t0);
+    return s;
+  }
+
+  ValidatorConfig vc;
+  vc.friction = cfg.friction;
+  const Eigen::Vector3d d_g = cfg.gravity.norm() > 0 ? cfg.gravity.normalized() : Eigen::Vector3d(0, 0, -1);
+  vc.gravity = 9.81 * d_g;
+  const PhysicsValidator validator(object_O, area_W, vc);
+  s.shape_ms = validator.shapeBuildMs();
+
+  // Indices are handed out in rank order (parallel_for.h), so the best start first; the budget
+  // is read before each start.
+  std::vector<PoseCheck> checks(picked.size());
+  std::vector<char> ran(picked.size(), 0);
+  parallelFor(picked.size(), s.threads, [&](size_t j) {
+    if (!may_start()) return;
+    checks[j] = validator.check(cands[picked[j]].X_WO, may_start);
+    ran[j] = !checks[j].interrupted;
+  });
+
+  double sim_ms = 0.0;
+  for (size_t j = 0; j < picked.size(); ++j) {
+    if (!ran[j]) continue;
+    PhysicsCheck& p = cands[picked[j]].physics;
+    p.checked = true;
+    p.stayed = checks[j].confirmed;
+    p.moved_m = checks[j].moved_m;
+    p.turned_deg = checks[j].turned_deg;
+    ++s.checked;
+    s.stayed += p.stayed;
+    sim_ms += checks[j].wall_ms;
+  }
+  s.per_check_ms = s.checked > 0 ? sim_ms / s.checked : 0.0;
+
+  // Checked and fell: behind the other stable candidates, ahead of the unstable ones; the order
+  // within each group is kept (stable partition in three groups).
+  const auto group = [](const Candidate& c) {
+    if (!c.stable) return 2;
+    return c.physics.checked && !c.physics.stayed ? 1 : 0;
+  };
+  std::stable_sort(cands.begin(), cands.end(),
+                   [&](const Candidate& a, const Candidate& b) { return group(a) < group(b); });
+  s.demoted = s.checked - s.stayed;
+  s.total_ms = msSince(t0);
+  return s;
 }
 
 }  // namespace validation

@@ -44,7 +44,7 @@ constexpr double kCancelLatency = 0.2;
 // Feedback is promised every 100 ms; allow scheduling jitter on a loaded 2-core CI machine.
 constexpr double kFeedbackGap = 0.15;
 // sizeof(PlannerConfig) when the YAML was last brought in line with it (x86-64, g++ 12).
-constexpr size_t kPlannerConfigSize = 256;
+constexpr size_t kPlannerConfigSize = 304;
 
 // The scene of the quick goals: a box on a 0.4 x 0.3 m plane at z = 0.
 Mesh testArea() { return scenes::plane(0.4, 0.3); }
@@ -468,20 +468,113 @@ TEST(PlacePlannerNode, BadGoalFieldIsInvalidGoalNamingIt) {
   EXPECT_NE(a.result.error_message.find("upside_down"), std::string::npos) << a.result.error_message;
 }
 
-TEST(PlacePlannerNode, TimeBudgetEndsLongPlanWithTimedOut) {
+// An answer cut by the time budget: TIMED_OUT (ABORTED) when nothing stable was found yet,
+// SUCCESS (SUCCEEDED) with partial = true and a message saying so when something was; never
+// any other code.
+void expectBudgetAnswer(const Answer& a) {
+  int stable = 0;
+  for (const auto& c : a.result.candidates) stable += c.stable;
+  if (a.result.error_code == Result::SUCCESS) {
+    EXPECT_TRUE(a.result.partial);
+    EXPECT_EQ(a.state, actionlib::SimpleClientGoalState::SUCCEEDED);
+    EXPECT_GT(stable, 0);
+    EXPECT_NE(a.result.error_message.find("partial answer: time budget"), std::string::npos)
+        << a.result.error_message;
+  } else {
+    EXPECT_EQ(a.result.error_code, Result::TIMED_OUT) << a.result.error_message;
+    EXPECT_FALSE(a.result.partial);
+    EXPECT_EQ(a.state, actionlib::SimpleClientGoalState::ABORTED);
+    EXPECT_EQ(stable, 0);
+  }
+}
+
+TEST(PlacePlannerNode, TimeBudgetEndsLongPlanWithPartialAnswerOrTimedOut) {
   PlacePlanGoal goal = longGoal();
   goal.time_budget = 0.3;  // s; the long plan needs several
   const ros::WallTime t0 = ros::WallTime::now();
   const Answer a = send(goal);
   const double wall = (ros::WallTime::now() - t0).toSec();
-  EXPECT_EQ(a.result.error_code, Result::TIMED_OUT) << a.result.error_message;
-  EXPECT_EQ(a.state, actionlib::SimpleClientGoalState::ABORTED);
+  expectBudgetAnswer(a);
   EXPECT_GE(a.result.planning_time, 0.3);
   EXPECT_LT(a.result.planning_time, 0.3 + kCancelLatency);
   EXPECT_LT(wall, 1.0);
-  std::printf("[budget] TIMED_OUT after %.3f s with %zu candidates\n", a.result.planning_time,
+  std::printf("[budget] %s after %.3f s with %zu candidates\n",
+              a.result.partial ? "partial SUCCESS" : "TIMED_OUT", a.result.planning_time,
               a.result.candidates.size());
   for (const auto& c : a.result.candidates) EXPECT_EQ(c.pose.header.frame_id, "world");
+}
+
+// The principal-axis start: the box rests on a face from it whatever the auto mode tries first.
+PlacePlanGoal boxOnPlaneGoal() {
+  PlacePlanGoal goal = quickGoal();
+  goal.object_mesh = meshMsg(testObject(), "");
+  goal.placement_area_mesh = meshMsg(testArea(), "world");
+  goal.orientation_mode = "principal_axis";
+  return goal;
+}
+
+TEST(PlacePlannerNode, TinyBudgetIsTimedOutOrPartialNeverElse) {
+  PlacePlanGoal goal = longGoal();
+  goal.orientation_mode = "principal_axis";
+  goal.time_budget = 0.001;  // s
+  expectBudgetAnswer(send(goal));
+  goal.verify_top_k = 3;  // the budget is spent: nothing is simulated
+  const Answer a = send(goal);
+  expectBudgetAnswer(a);
+  for (const auto& c : a.result.candidates) EXPECT_FALSE(c.physics_checked);
+}
+
+// A 40 degree slope with mu = 0.05 (tan 40 = 0.84): nothing can rest on it; the search completes.
+TEST(PlacePlannerNode, SteepSlopeWithLowFrictionIsNoStablePose) {
+  PlacePlanGoal goal = boxOnPlaneGoal();
+  goal.placement_area_mesh = meshMsg(scenes::plane(0.6, 0.6, 40.0), "world");
+  goal.friction = 0.05;
+  goal.verify_top_k = 2;  // nothing stable: nothing to simulate
+  const Answer a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::NO_STABLE_POSE) << a.result.error_message;
+  EXPECT_EQ(a.state, actionlib::SimpleClientGoalState::ABORTED);
+  EXPECT_FALSE(a.result.partial);
+  EXPECT_EQ(a.result.error_message.rfind("no stable pose: ", 0), 0u) << a.result.error_message;
+  for (const auto& c : a.result.candidates) {
+    EXPECT_FALSE(c.stable);
+    EXPECT_FALSE(c.physics_checked);
+  }
+}
+
+// verify_top_k = 2: Bullet checks the best two stable candidates (a box on a face of the plane
+// stays put), none of the others; 0 takes the parameter (0 = off), < 0 is off.
+TEST(PlacePlannerNode, VerifyTopKChecksTheBestTwoStableCandidates) {
+  PlacePlanGoal goal = boxOnPlaneGoal();
+  goal.verify_top_k = 2;
+  const Answer a = send(goal);
+  ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  EXPECT_FALSE(a.result.partial);
+  const auto& cs = a.result.candidates;
+  ASSERT_GE(cs.size(), 3u);
+  ASSERT_TRUE(cs[0].stable && cs[1].stable);
+  for (size_t i = 0; i < cs.size(); ++i) {
+    EXPECT_EQ(cs[i].physics_checked, i < 2) << "candidate " << i + 1;
+    if (i < 2) {
+      EXPECT_TRUE(cs[i].physics_stayed) << "candidate " << i + 1 << " moved " << cs[i].physics_moved
+                                        << " m, turned " << cs[i].physics_turned << " deg";
+      EXPECT_LT(cs[i].physics_moved, 0.01);
+      EXPECT_LT(cs[i].physics_turned, 5.0);
+    } else {
+      EXPECT_FALSE(cs[i].physics_stayed);
+    }
+    EXPECT_FALSE(cs[i].start.empty());
+    EXPECT_GE(cs[i].robust_share, 0.0);
+    EXPECT_LE(cs[i].robust_share, 1.0);
+    EXPECT_GE(cs[i].robust_trials, 0);
+  }
+  std::printf("[verify] best two: moved %.4f / %.4f m, turned %.2f / %.2f deg\n", cs[0].physics_moved,
+              cs[1].physics_moved, cs[0].physics_turned, cs[1].physics_turned);
+  for (const int k : {0, -1}) {
+    goal.verify_top_k = k;
+    const Answer b = send(goal);
+    ASSERT_EQ(b.result.error_code, Result::SUCCESS) << b.result.error_message;
+    for (const auto& c : b.result.candidates) EXPECT_FALSE(c.physics_checked) << "verify_top_k " << k;
+  }
 }
 
 // ---------------------------------------------------------------- parameters
@@ -503,11 +596,31 @@ TEST(PlacePlannerParams, OutOfRangeAndWrongTypeAreNamed) {
     EXPECT_NE(std::string(e.what()).find("/params_test/gravity"), std::string::npos) << e.what();
   }
   nh.setParam("gravity", std::vector<double>{0.0, -1.0, 0.0});
+  nh.setParam("verify_top_k", -1);
+  try {
+    loadNodeConfig(nh);
+    ADD_FAILURE() << "verify_top_k -1 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/params_test/verify_top_k"), std::string::npos) << e.what();
+  }
+  nh.setParam("verify_top_k", 3);
+  nh.setParam("robust_check", 1.5);
+  try {
+    loadNodeConfig(nh);
+    ADD_FAILURE() << "robust_check 1.5 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/params_test/robust_check"), std::string::npos) << e.what();
+  }
+  nh.setParam("robust_check", false);
+  nh.setParam("robust_shift", 0.004);
   nh.setParam("orientation", std::string("keep"));
   const NodeConfig c = loadNodeConfig(nh);
   EXPECT_DOUBLE_EQ(c.planner.friction, 0.4);
   EXPECT_EQ(c.planner.gravity, Eigen::Vector3d(0, -1, 0));
   EXPECT_EQ(c.planner.orientation, OrientationMode::kKeep);
+  EXPECT_EQ(c.verify_top_k, 3);
+  EXPECT_FALSE(c.planner.robust_check);
+  EXPECT_DOUBLE_EQ(c.planner.robust_shift, 0.004);
   EXPECT_EQ(c.planner.max_candidates, PlannerConfig().max_candidates);  // default kept
   nh.deleteParam("");
 }
@@ -519,7 +632,9 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
   ros::NodeHandle nh("/place_planner");
   for (const char* name :
        {"gravity", "approach", "friction", "floor_point_spacing", "min_floor_points", "lowest_n",
-        "max_rotations", "sphere_radius", "grid_cell_size", "orientation", "time_budget_ms",
+        "max_rotations", "sphere_radius", "grid_cell_size", "orientation", "max_resting_faces",
+        "robust_shift", "robust_tilt_deg", "robust_com_offset", "robust_min_share", "robust_check",
+        "time_budget_ms", "verify_top_k",
         "max_candidates", "threads", "max_local_optimisation_steps", "min_support_width", "min_tipping_angle_deg",
         "min_quality", "merge_distance", "merge_angle_deg", "backend", "region_min", "region_max",
         "planning_frame", "tf_timeout", "feedback_period", "marker_candidates",
@@ -527,6 +642,7 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
     EXPECT_TRUE(nh.hasParam(name)) << name << " missing from config/place_planner.yaml";
   }
   const PlannerConfig d;
+  EXPECT_EQ(loadNodeConfig(nh).verify_top_k, NodeConfig().verify_top_k);
   const PlannerConfig y = loadNodeConfig(nh).planner;
   EXPECT_EQ(y.gravity, d.gravity);
   EXPECT_EQ(y.approach, d.approach);
@@ -538,6 +654,12 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
   EXPECT_EQ(y.sphere_radius, d.sphere_radius);
   EXPECT_EQ(y.grid_cell_size, d.grid_cell_size);
   EXPECT_EQ(y.orientation, d.orientation);
+  EXPECT_EQ(y.max_resting_faces, d.max_resting_faces);
+  EXPECT_EQ(y.robust_shift, d.robust_shift);
+  EXPECT_EQ(y.robust_tilt_deg, d.robust_tilt_deg);
+  EXPECT_EQ(y.robust_com_offset, d.robust_com_offset);
+  EXPECT_EQ(y.robust_min_share, d.robust_min_share);
+  EXPECT_EQ(y.robust_check, d.robust_check);
   EXPECT_EQ(y.time_budget_ms, d.time_budget_ms);
   EXPECT_EQ(y.max_candidates, d.max_candidates);
   EXPECT_EQ(y.threads, d.threads);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "place_planner/mesh_io.h"
+#include "place_planner/planner.h"
 #include "place_planner/scenes.h"
 #include "place_planner/validation/physics_validator.h"
 #include "validation_test_helpers.h"
@@ -210,6 +211,156 @@ TEST(PhysicsValidator, YcbMugUprightOnSharedTable) {
   X.translation().z() = -mug.properties.bounds_min.z();
   const PoseCheck r = v.check(X);
   EXPECT_TRUE(r.confirmed) << "moved " << r.moved_m << " m, turned " << r.turned_deg << " deg";
+}
+
+// ---------------------------------------------------------------- verifyTopK (issue 9)
+
+// The cube on the built-in table, planned from the principal axis (any core: it rests on a face).
+PlannerConfig cubePlanConfig() {
+  PlannerConfig c;
+  c.orientation = OrientationMode::kPrincipalAxis;
+  c.max_candidates = 10;
+  c.threads = 2;
+  return c;
+}
+
+PlanResult cubeOnTable(const PlannerConfig& c) { return Planner().plan(cube(), scenes::table(), c); }
+
+// A candidate the planner called stable by hand.
+Candidate handMade(const Eigen::Isometry3d& X_WO, double quality) {
+  Candidate k;
+  k.X_WO = X_WO;
+  k.quality = quality;
+  k.stable = true;
+  return k;
+}
+
+TEST(VerifyTopK, CubeOnTableTopCandidatesStayAndTheRestAreUnchecked) {
+  const PlannerConfig c = cubePlanConfig();
+  PlanResult r = cubeOnTable(c);
+  ASSERT_GE(r.stableCount(), 4) << "the cube on the table has many stable floor points";
+  ASSERT_TRUE(r.candidates[0].stable);
+  const std::vector<Candidate> before = r.candidates;
+  const VerifyStats s = verifyTopK(cube(), scenes::table(), c, r, 3, 0.0, 2);
+  EXPECT_EQ(s.selected, 3);
+  EXPECT_EQ(s.checked, 3);
+  EXPECT_EQ(s.stayed, 3);
+  EXPECT_EQ(s.demoted, 0);
+  EXPECT_GT(s.per_check_ms, 0.0);
+  ASSERT_EQ(r.candidates.size(), before.size());
+  for (size_t i = 0; i < r.candidates.size(); ++i) {
+    const PhysicsCheck& p = r.candidates[i].physics;
+    // Nothing fell, so nothing moved in the ranking.
+    EXPECT_TRUE(r.candidates[i].X_WO.isApprox(before[i].X_WO)) << i;
+    if (i < 3) {
+      EXPECT_TRUE(p.checked) << i;
+      EXPECT_TRUE(p.stayed) << i << ": moved " << p.moved_m << " m, turned " << p.turned_deg;
+      EXPECT_LT(p.moved_m, 0.003) << i;  // the 2 mm release gap, settled
+      EXPECT_LT(p.turned_deg, 0.5) << i;
+    } else {
+      EXPECT_FALSE(p.checked) << i;
+      EXPECT_FALSE(p.stayed) << i;
+    }
+  }
+}
+
+// A cube balanced on a corner, tilted 30 degrees, injected as the best "stable" candidate ahead
+// of a cube flat on the table: Bullet sees it fall (turns far more than 5 degrees); it moves
+// behind the flat one, still ahead of an unstable candidate, which is not simulated.
+TEST(VerifyTopK, CubeTiltedOnACornerFallsAndMovesDownTheRanking) {
+  const Mesh object = cube();
+  Eigen::Isometry3d X_tilted = Eigen::Isometry3d::Identity();
+  X_tilted.linear() = Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d(1, 1, 0).normalized())
+                          .toRotationMatrix();
+  double min_z = 1e9;
+  for (const auto& v : object.vertices) min_z = std::min(min_z, (X_tilted * v).z());
+  X_tilted.translation() = Eigen::Vector3d(0.1, 0.1, -min_z);  // lowest corner on the table
+  Eigen::Isometry3d X_flat = Eigen::Isometry3d::Identity();
+  X_flat.translation() = Eigen::Vector3d(-0.2, 0.0, 0.0);
+  Candidate unstable = handMade(X_flat, 0.2);
+  unstable.stable = false;
+
+  PlanResult r;
+  r.candidates = {handMade(X_tilted, 0.9), handMade(X_flat, 0.8), unstable};
+  const VerifyStats s = verifyTopK(object, scenes::table(), cubePlanConfig(), r, 5, 0.0, 2);
+  EXPECT_EQ(s.selected, 2);  // the unstable one does not count
+  EXPECT_EQ(s.checked, 2);
+  EXPECT_EQ(s.stayed, 1);
+  EXPECT_EQ(s.demoted, 1);
+  ASSERT_EQ(r.candidates.size(), 3u);
+  // New order: flat (stayed), tilted (fell), unstable (not simulated).
+  EXPECT_DOUBLE_EQ(r.candidates[0].quality, 0.8);
+  EXPECT_TRUE(r.candidates[0].physics.checked);
+  EXPECT_TRUE(r.candidates[0].physics.stayed);
+  const PhysicsCheck& fell = r.candidates[1].physics;
+  EXPECT_DOUBLE_EQ(r.candidates[1].quality, 0.9);
+  EXPECT_TRUE(fell.checked);
+  EXPECT_FALSE(fell.stayed);
+  EXPECT_GT(fell.turned_deg, 5.0) << "moved " << fell.moved_m << " m";
+  EXPECT_TRUE(r.candidates[1].stable) << "the planner's verdict is kept";
+  EXPECT_DOUBLE_EQ(r.candidates[2].quality, 0.2);
+  EXPECT_FALSE(r.candidates[2].physics.checked);
+}
+
+TEST(VerifyTopK, KLargerThanTheCandidatesChecksEveryStableOne) {
+  PlannerConfig c = cubePlanConfig();
+  c.max_candidates = 4;
+  PlanResult r = cubeOnTable(c);
+  ASSERT_FALSE(r.candidates.empty());
+  const VerifyStats s = verifyTopK(cube(), scenes::table(), c, r, 50, 0.0, 2);
+  EXPECT_EQ(s.selected, r.stableCount());
+  EXPECT_EQ(s.checked, r.stableCount());
+  for (const Candidate& k : r.candidates) EXPECT_EQ(k.physics.checked, k.stable);
+  // Nothing to check: no stable candidate, k = 0.
+  PlanResult none;
+  EXPECT_EQ(verifyTopK(cube(), scenes::table(), c, none, 5, 0.0, 2).checked, 0);
+  EXPECT_EQ(verifyTopK(cube(), scenes::table(), c, r, 0, 0.0, 2).checked, 0);
+  for (const Candidate& k : r.candidates) EXPECT_FALSE(k.physics.checked) << "k = 0 resets";
+}
+
+// One check of the cube takes a few ms (2 s simulated, or 0.6 s with the early accept): a 1 ms
+// budget leaves time for at most one start per thread, and such a check is interrupted.
+TEST(VerifyTopK, TinyBudgetChecksFewer) {
+  const PlannerConfig c = cubePlanConfig();
+  PlanResult r = cubeOnTable(c);
+  ASSERT_GE(r.stableCount(), 8);
+  PlanResult full = r;
+  const VerifyStats all = verifyTopK(cube(), scenes::table(), c, full, 8, 0.0, 2);
+  EXPECT_EQ(all.checked, 8);
+  const VerifyStats few = verifyTopK(cube(), scenes::table(), c, r, 8, 1.0, 2);
+  EXPECT_EQ(few.selected, 8);
+  EXPECT_LE(few.checked, 2);
+  EXPECT_LT(few.total_ms, 0.5 * all.total_ms) << "the budget did not cut the work";
+  int checked = 0;
+  for (const Candidate& k : r.candidates) checked += k.physics.checked;
+  EXPECT_EQ(checked, few.checked);
+  // A cancel before the start: nothing is simulated.
+  const VerifyStats cancelled =
+      verifyTopK(cube(), scenes::table(), c, r, 8, 0.0, 2, [] { return false; });
+  EXPECT_EQ(cancelled.checked, 0);
+}
+
+// One validator's shapes shared by two threads give exactly the single-thread results.
+TEST(VerifyTopK, TwoThreadsGiveTheSameVerdicts) {
+  const PlannerConfig c = cubePlanConfig();
+  PlanResult one = cubeOnTable(c), two = one;
+  verifyTopK(cube(), scenes::table(), c, one, 6, 0.0, 1);
+  verifyTopK(cube(), scenes::table(), c, two, 6, 0.0, 2);
+  ASSERT_EQ(one.candidates.size(), two.candidates.size());
+  for (size_t i = 0; i < one.candidates.size(); ++i) {
+    EXPECT_EQ(one.candidates[i].physics.checked, two.candidates[i].physics.checked) << i;
+    EXPECT_EQ(one.candidates[i].physics.stayed, two.candidates[i].physics.stayed) << i;
+    EXPECT_EQ(one.candidates[i].physics.moved_m, two.candidates[i].physics.moved_m) << i;
+    EXPECT_EQ(one.candidates[i].physics.turned_deg, two.candidates[i].physics.turned_deg) << i;
+  }
+}
+
+TEST(VerifyTopK, RemainingBudget) {
+  EXPECT_EQ(remainingBudgetMs(0.0, 50.0), 0.0);  // no budget: no limit
+  EXPECT_DOUBLE_EQ(remainingBudgetMs(100.0, 30.0), 70.0);
+  const double spent = remainingBudgetMs(100.0, 150.0);
+  EXPECT_GT(spent, 0.0) << "a spent budget must not read as no limit";
+  EXPECT_LT(spent, 1e-3);
 }
 
 }  // namespace

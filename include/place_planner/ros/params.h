@@ -16,6 +16,9 @@ struct NodeConfig {
   double feedback_period = 0.05;         // s, at most this long between feedback messages
   int marker_candidates = 10;            // object outlines drawn (best first)
   int marker_text_count = 3;             // "Q = ..." labels for the best few
+  // Bullet check of the best K stable candidates after each plan (validation::verifyTopK), within
+  // what is left of the time budget; a goal's verify_top_k overrides it. 0 = off.
+  int verify_top_k = 0;
   PlannerConfig planner;
 };
 

@@ -17,9 +17,11 @@
 //    surface centroid the planner uses), inertia of the solid bounding box about c_O.
 #pragma once
 #include <Eigen/Geometry>
+#include <functional>
 #include <memory>
 
 #include "place_planner/mesh.h"
+#include "place_planner/planner.h"
 
 namespace place_planner {
 namespace validation {
@@ -75,6 +77,7 @@ struct PoseCheck {
   double turned_deg = 0.0;     // rotation angle, goal -> final
   bool aborted = false;        // stopped early (moved past abort_*)
   bool early_accepted = false; // stopped early, still within half the thresholds
+  bool interrupted = false;    // stopped by keep_going (no verdict: confirmed is false)
   double sim_time = 0.0;       // s simulated
   double wall_ms = 0.0;
   Eigen::Isometry3d X_WO_final = Eigen::Isometry3d::Identity();
@@ -91,8 +94,9 @@ struct DropResult {
 };
 
 // Builds the collision shapes once per object/area pair; every check() or drop() runs in a fresh
-// dynamics world, so results do not depend on earlier calls (deterministic).
-// Not thread-safe: use one PhysicsValidator per thread.
+// dynamics world, so results do not depend on earlier calls (deterministic). check() and drop()
+// may run concurrently on one validator: each call owns its world, bodies and solver and only
+// reads the shared shapes (verifyTopK does so; test_physics_validator compares 1 and 2 threads).
 class PhysicsValidator {
  public:
   // Throws std::invalid_argument for an empty mesh or a bad config value (naming the field).
@@ -102,6 +106,9 @@ class PhysicsValidator {
   PhysicsValidator& operator=(const PhysicsValidator&) = delete;
 
   PoseCheck check(const Eigen::Isometry3d& X_WO_goal) const;
+  // The same, asking keep_going every 16 steps (about 33 ms of simulated time; 1-100 ms of wall
+  // time, measured); false interrupts the run without a verdict (a deadline, a cancel).
+  PoseCheck check(const Eigen::Isometry3d& X_WO_goal, const std::function<bool()>& keep_going) const;
   DropResult drop(const Eigen::Isometry3d& X_WO_start) const;
 
   const ValidatorConfig& config() const;
@@ -114,6 +121,41 @@ class PhysicsValidator {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// What verifyTopK did (timings are wall times of this call).
+struct VerifyStats {
+  int selected = 0;        // stable candidates among the best K (the ones it would check)
+  int checked = 0;         // ... simulated before the budget ran out
+  int stayed = 0;          // ... that stayed put
+  int demoted = 0;         // checked, did not stay, moved behind the other stable candidates
+  double shape_ms = 0.0;   // building the Bullet shapes (once per call)
+  double total_ms = 0.0;   // the whole call: shapes + simulations
+  double per_check_ms = 0.0;  // mean wall time of one simulation (one thread)
+  int threads = 1;
+};
+
+// Physics check in the product (issue 9): simulates the best `k` stable candidates of `result`
+// (candidates are ranked best first; unstable ones are skipped and do not count against k) with
+// check() above, released 2 mm above the pose: stayed = moved < 1 cm and turned < 5 deg. The
+// object gets the plan's friction mu, gravity is 9.81 m/s^2 along cfg.gravity; everything else
+// is ValidatorConfig's default. One validator (the shapes are built once per call), the checks
+// run in rank order on `threads` threads (0 = all hardware threads), each in its own Bullet world.
+// budget_ms: wall time for the whole call (shapes included); once it is spent no new check starts
+// and a running one is interrupted within 16 steps (it counts as not checked); <= 0 = no limit.
+// keep_going (optional, e.g. a cancelled goal): asked as often, false has the same effect.
+// Fills Candidate::physics of every candidate (reset first: not checked = checked false).
+// Ranking: a checked candidate that did not stay put keeps stable = true (the planner's verdict)
+// but is moved behind every other stable candidate (still ahead of the unstable ones); all
+// others keep their order. k <= 0 or no stable candidate: nothing is simulated, nothing moves.
+// Throws std::invalid_argument for an empty mesh (from PhysicsValidator).
+VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerConfig& cfg,
+                       PlanResult& result, int k, double budget_ms, int threads,
+                       const std::function<bool()>& keep_going = {});
+
+// The budget verifyTopK gets from a plan's config and its planning time: 0 (no limit) when the
+// plan had none, else what is left, at least a tiny positive amount (a spent budget checks
+// nothing; it must not read as "no limit").
+double remainingBudgetMs(double plan_budget_ms, double used_ms);
 
 // Rotation angle between two orientations, degrees in [0, 180].
 double rotationAngleDeg(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b);

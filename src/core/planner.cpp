@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <future>
 #include <mutex>
 
@@ -219,10 +218,6 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   }, &st);
   if (budget > 0 && msSince(t0) > budget) result.timed_out = true;
   st.total_ms = msSince(t0);
-  if (std::getenv("PP_STATS"))
-    std::fprintf(stderr, "[stats] roots %d orientations %d leaves %zu tree_nodes %ld robust checked %d rejected %d %.1f ms, without rest %d, total %.1f\n",
-                 st.roots_total, st.start_orientations, leaves.size(), st.tree_nodes, st.robustness_checked,
-                 st.robustness_rejected, st.robustness_ms, st.trees_without_rest, st.total_ms);
   return result;
 }
 

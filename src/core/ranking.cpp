@@ -25,10 +25,23 @@ struct Item {
   }
 };
 
+// Scores equal to 1e-3 are ties (the same placement seen through another frame differs only
+// by rounding); ties go to the pose nearer the frame's vertical axis, then by position on a 1 mm
+// lattice: an order that depends on the geometry, not on the order roots were tried in.
+long quantised(double v, double step) { return std::lround(v / step); }
+
 void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
   std::stable_sort(items.begin(), items.end(), [&](const Item& a, const Item& b) {
     if (a.stable != b.stable) return a.stable;
-    if (a.score() != b.score()) return a.score() > b.score();
+    const long sa = quantised(a.score(), 1e-3), sb = quantised(b.score(), 1e-3);
+    if (sa != sb) return sa > sb;
+    const V3 pa = leaves[a.leaf].X_GO.t, pb = leaves[b.leaf].X_GO.t;
+    const long ra = quantised(pa.x * pa.x + pa.y * pa.y, 1e-6), rb = quantised(pb.x * pb.x + pb.y * pb.y, 1e-6);
+    if (ra != rb) return ra < rb;
+    const long xa = quantised(pa.x, 1e-3), xb = quantised(pb.x, 1e-3);
+    if (xa != xb) return xa < xb;
+    const long ya = quantised(pa.y, 1e-3), yb = quantised(pb.y, 1e-3);
+    if (ya != yb) return ya < yb;
     return leaves[a.leaf].root < leaves[b.leaf].root;
   });
 }

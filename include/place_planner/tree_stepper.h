@@ -27,6 +27,9 @@ struct TreeNode {
   bool both_directions = true;
   bool local_rotation = false;
   std::vector<ContactPoint> contacts;  // frame G
+  // Its last stability test, kept while it turns: a leaf when no turn is found.
+  double quality = -1, tipping_angle = 0;
+  bool supported = false;
 };
 
 struct TreeLeaf {
@@ -34,6 +37,9 @@ struct TreeLeaf {
   int root = 0;
   bool stable = false;
   bool at_rest = true;   // false: cut by max_rotations while still tilting
+  // Statically supported: the centre of mass inside the support with the tipping margin and
+  // friction holding, without the quality bound that `stable` adds (robustness trials).
+  bool supported = false;
   double quality = -1;
   double tipping_angle = 0;  // rad (planar supports)
   std::vector<ContactPoint> contacts;  // frame G
@@ -68,7 +74,7 @@ class TreeStepper {
  private:
   void firstContactStep();                        // V-A
   void contactStep(std::vector<TreeLeaf>& leaves);  // V-B, VI, V-C.1
-  void tiltStep();                                // V-C.2
+  void tiltStep(std::vector<TreeLeaf>& leaves);   // V-C.2
   TreeContext ctx_;
   double diag_;  // of the area's bounds, limits slides
   std::vector<TreeNode> translate_, contact_, rotating_;

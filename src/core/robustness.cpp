@@ -77,14 +77,16 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
     stepper.step(leaves);
   }
   const std::vector<int> open = finished ? std::vector<int>{} : stepper.openRoots();
-  // A trial holds when it ended (all its leaves: a tree may branch) stable near the pose.
+  // A trial holds when it ended (all its leaves: a tree may branch) near the pose, stable or
+  // statically supported (centre of mass inside its support with the tipping margin: a release
+  // that settles a fraction of a degree off flat has a partial contact band).
   std::vector<int> state(X_GO.size() * kTrials, 0);  // 0 no leaf, 1 held, -1 failed
   std::vector<double> tip(state.size(), kInf);
   for (const TreeLeaf& l : leaves) {
     const size_t i = l.root / kTrials;
     const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(l.X_GO, om.com));
     const bool near = (c1 - c0).norm() <= p.end_distance && angleBetween(l.X_GO, X_GO[i]) <= p.end_angle;
-    const bool held = l.stable && near;
+    const bool held = (l.stable || l.supported) && near;
     if (std::getenv("PP_TRACE_ROBUST"))
       std::fprintf(stderr, "trial %d of %zu: stable %d at_rest %d moved %.1f mm turned %.1f deg path %zu\n", l.root % kTrials, i,
                    l.stable, l.at_rest, 1000 * (c1 - c0).norm(), angleBetween(l.X_GO, X_GO[i]) * 180 / M_PI, l.path.size());
@@ -93,6 +95,9 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
     if (held) tip[l.root] = std::min(tip[l.root], l.tipping_angle);
   }
   for (int r : open) state[r] = -1;
+  if (std::getenv("PP_TRACE_ROBUST"))
+    for (size_t k = 0; k < state.size(); ++k)
+      if (state[k] == 0) std::fprintf(stderr, "trial %zu of %zu: no leaf\n", k % kTrials, k / kTrials);
   std::vector<Robustness> out(X_GO.size());
   for (size_t i = 0; i < X_GO.size(); ++i) {
     Robustness& r = out[i];

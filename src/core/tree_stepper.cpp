@@ -81,7 +81,7 @@ std::vector<int> TreeStepper::openRoots() const {
 void TreeStepper::step(std::vector<TreeLeaf>& leaves) {
   if (!translate_.empty()) firstContactStep();
   if (!contact_.empty()) contactStep(leaves);
-  if (!rotating_.empty()) tiltStep();
+  if (!rotating_.empty()) tiltStep(leaves);
 }
 
 // ---------------------------------------------------------------- first contact (V-A)
@@ -135,9 +135,14 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     const Eigen::Vector3d com = toEigen(apply(n.X_GO, n.com_O));
     const Stability& s = stab[i];
     const TiltAxis& axis = axes[i];
+    const bool supported = s.stable || (s.planar && s.friction_ok && s.com_inside &&
+                                        s.tipping_angle >= ctx_.stability.min_tipping_angle);
     auto leaf = [&](bool stable, bool at_rest) {
-      leaves.push_back(TreeLeaf{n.X_GO, n.root, stable, at_rest, s.quality, s.tipping_angle, n.contacts, n.path});
+      leaves.push_back(TreeLeaf{n.X_GO, n.root, stable, at_rest, supported, s.quality, s.tipping_angle, n.contacts, n.path});
     };
+    n.quality = s.quality;
+    n.tipping_angle = s.tipping_angle;
+    n.supported = supported;
     if (kTrace)
       std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d tip %.1f deg Q %.3f\n",
                    n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable,
@@ -194,7 +199,7 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
 
 // ---------------------------------------------------------------- tilt angles (V-C.2)
 // Exact angles to the next contact, vertex/surface and edge/edge, in both directions.
-void TreeStepper::tiltStep() {
+void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
   std::vector<RotationQuery> q;
   for (const TreeNode& n : rotating_) {
     RotationQuery rq{n.X_GO, toV3(n.s_A), toV3(n.d_A)};
@@ -226,6 +231,7 @@ void TreeStepper::tiltStep() {
   addTime(ctx_.times ? &ctx_.times->tilt_edge : nullptr, t0);
   for (size_t i = 0; i < rotating_.size(); ++i) {
     const TreeNode& n = rotating_[i];
+    bool turned = false;
     for (int sigma : {1, -1}) {
       if (sigma < 0 && !n.both_directions) continue;
       const double a = sigma > 0 ? std::min(av[i].ccw, ae[i].ccw) : std::min(av[i].cw, ae[i].cw);
@@ -244,7 +250,12 @@ void TreeStepper::tiltStep() {
       c.path = n.path;
       c.path.push_back(c.X_GO);
       contact_.push_back(std::move(c));
+      turned = true;
     }
+    // No turn found either way (blocked, or the object turns off the area): the tree ends here,
+    // not stable, statically supported or not as its last test said.
+    if (!turned)
+      leaves.push_back(TreeLeaf{n.X_GO, n.root, false, true, n.supported, n.quality, n.tipping_angle, n.contacts, n.path});
   }
   rotating_.clear();
 }

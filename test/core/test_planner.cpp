@@ -207,6 +207,7 @@ TEST(Planner, MergesNearbyPoses) {
   PlannerConfig cfg;
   cfg.floor_point_spacing = 0.05;
   cfg.merge_distance = 0.06;  // wider than the spacing: neighbouring floor points merge
+  cfg.max_candidates = 200;   // all of them
   const PlanResult r = Planner().plan(scenes::byName("cube"), scenes::table(), cfg);
   cfg.merge_distance = 0.0;
   const PlanResult all = Planner().plan(scenes::byName("cube"), scenes::table(), cfg);

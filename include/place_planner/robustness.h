@@ -19,6 +19,8 @@ struct RobustnessParams {
   double end_distance = 0.01;      // m, a trial holds when it ends this close ...
   double end_angle = 5.0 * M_PI / 180;  // ... and this little turned, stable
   int max_rotations = 3;           // of each trial's tree
+  double min_share = 1.0;          // a pose with more failed trials than this allows is decided
+                                   // (its other trials stop early); the counts are then partial
 };
 
 // Settles 12 perturbed releases of each pose with the planner's own kernels (translation to

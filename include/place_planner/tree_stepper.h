@@ -3,6 +3,7 @@
 // translations pending; its leaves are resting poses (stable or not).
 #pragma once
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "place_planner/backend.h"
@@ -70,6 +71,8 @@ class TreeStepper {
   void step(std::vector<TreeLeaf>& leaves);
   // Roots with poses still pending, sorted, unique.
   std::vector<int> openRoots() const;
+  // Drops every pending pose for which drop(node) is true (a tree whose outcome is known).
+  void prune(const std::function<bool(const TreeNode&)>& drop);
 
  private:
   void firstContactStep();                        // V-A

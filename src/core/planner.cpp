@@ -154,6 +154,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   rp.shift = config.robust_shift;
   rp.tilt = config.robust_tilt_deg * M_PI / 180.0;
   rp.com_offset = config.robust_com_offset;
+  rp.min_share = config.robust_min_share;
   auto robustness = [&](const std::vector<size_t>& idx, const std::vector<TreeLeaf>& leaves) {
     const auto tr = Clock::now();
     std::vector<Rigid> X;

@@ -67,6 +67,22 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
       const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
       stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax);
     }
+  // A trial holds when it ended (all its leaves: a tree may branch) near the pose, stable or
+  // statically supported (centre of mass inside its support with the tipping margin: a release
+  // that settles a fraction of a degree off flat has a partial contact band).
+  std::vector<int> state(X_GO.size() * kTrials, 0);  // 0 open or no leaf, 1 held, -1 failed
+  std::vector<double> tip(state.size(), kInf);
+  std::vector<int> failures(X_GO.size(), 0);
+  // Every trial must hold when min_share is 1: a pose's first failure ends its other trials.
+  const int allowed = static_cast<int>(std::floor((1.0 - p.min_share) * kTrials + 1e-9));
+  auto near = [&](const Rigid& X, size_t i, double scale) {
+    const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(X, om.com));
+    return (c1 - c0).norm() <= scale * p.end_distance && angleBetween(X, X_GO[i]) <= scale * p.end_angle;
+  };
+  auto fail = [&](int trial) {
+    if (state[trial] != -1) ++failures[trial / kTrials];
+    state[trial] = -1;
+  };
   std::vector<TreeLeaf> leaves;
   bool finished = true;
   while (!stepper.empty()) {
@@ -74,30 +90,31 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
       finished = false;
       break;
     }
+    leaves.clear();
     stepper.step(leaves);
+    for (const TreeLeaf& l : leaves) {
+      const size_t i = l.root / kTrials;
+      const bool held = (l.stable || l.supported) && near(l.X_GO, i, 1.0);
+      if (!held) fail(l.root);
+      else if (state[l.root] == 0) state[l.root] = 1;
+      if (held) tip[l.root] = std::min(tip[l.root], l.tipping_angle);
+    }
+    // A trial that has moved or turned twice the limit away does not come back: failed. A pose
+    // with more failures than allowed is decided: its open trials stop.
+    stepper.prune([&](const TreeNode& n) {
+      const size_t i = n.root / kTrials;
+      if (failures[i] <= allowed && near(n.X_GO, i, 2.0)) return false;
+      if (failures[i] <= allowed) fail(n.root);
+      return true;
+    });
   }
-  const std::vector<int> open = finished ? std::vector<int>{} : stepper.openRoots();
-  // A trial holds when it ended (all its leaves: a tree may branch) near the pose, stable or
-  // statically supported (centre of mass inside its support with the tipping margin: a release
-  // that settles a fraction of a degree off flat has a partial contact band).
-  std::vector<int> state(X_GO.size() * kTrials, 0);  // 0 no leaf, 1 held, -1 failed
-  std::vector<double> tip(state.size(), kInf);
-  for (const TreeLeaf& l : leaves) {
-    const size_t i = l.root / kTrials;
-    const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(l.X_GO, om.com));
-    const bool near = (c1 - c0).norm() <= p.end_distance && angleBetween(l.X_GO, X_GO[i]) <= p.end_angle;
-    const bool held = (l.stable || l.supported) && near;
-    if (std::getenv("PP_TRACE_ROBUST"))
-      std::fprintf(stderr, "trial %d of %zu: stable %d at_rest %d moved %.1f mm turned %.1f deg path %zu\n", l.root % kTrials, i,
-                   l.stable, l.at_rest, 1000 * (c1 - c0).norm(), angleBetween(l.X_GO, X_GO[i]) * 180 / M_PI, l.path.size());
-    if (!held) state[l.root] = -1;
-    else if (state[l.root] == 0) state[l.root] = 1;
-    if (held) tip[l.root] = std::min(tip[l.root], l.tipping_angle);
-  }
-  for (int r : open) state[r] = -1;
-  if (std::getenv("PP_TRACE_ROBUST"))
-    for (size_t k = 0; k < state.size(); ++k)
-      if (state[k] == 0) std::fprintf(stderr, "trial %zu of %zu: no leaf\n", k % kTrials, k / kTrials);
+  // Trials cut by the caller fail.
+  if (!finished)
+    for (int r : stepper.openRoots()) fail(r);
+  std::vector<char> has_leaf(state.size(), 0);
+  for (size_t k = 0; k < state.size(); ++k) has_leaf[k] = state[k] != 0;
+  for (size_t k = 0; k < state.size(); ++k)
+    if (!has_leaf[k]) state[k] = -1;  // the tree vanished (fell off the area)
   std::vector<Robustness> out(X_GO.size());
   for (size_t i = 0; i < X_GO.size(); ++i) {
     Robustness& r = out[i];

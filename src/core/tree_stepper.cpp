@@ -78,6 +78,11 @@ std::vector<int> TreeStepper::openRoots() const {
   return open;
 }
 
+void TreeStepper::prune(const std::function<bool(const TreeNode&)>& drop) {
+  for (auto* list : {&translate_, &contact_, &rotating_})
+    list->erase(std::remove_if(list->begin(), list->end(), drop), list->end());
+}
+
 void TreeStepper::step(std::vector<TreeLeaf>& leaves) {
   if (!translate_.empty()) firstContactStep();
   if (!contact_.empty()) contactStep(leaves);
@@ -148,13 +153,10 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
                    n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable,
                    s.tipping_angle * 180 / M_PI, s.quality);
     if (n.contacts.empty()) continue;
-    // One contact never holds an object (a ball rolls): tilt (Section V-C) about it. Contacts
-    // along a line are a band of touching surface (a cylinder lying on its side, a marker on
-    // its barrel): they hold only when that band passes the stability test with its tipping
-    // margin (the pose is then neutral in roll at worst, and the robustness check releases it
-    // tilted); otherwise the object tilts about the line.
-    const bool line = axis.layout == ContactLayout::kSingle ||
-                      (axis.layout == ContactLayout::kCollinear && !s.stable);
+    // One contact or a line of contacts never holds an object (a ball rolls, a cylinder on its
+    // side turns about its line): tilt (Section V-C) about the point or the line. (Accepting a
+    // band of contacts along a line as a support was tried: Bullet rolled every such marker.)
+    const bool line = axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear;
     const bool can_turn = n.depth < ctx_.max_rotations &&
                           n.turns < kMaxTurnsPerRotation * std::max(1, ctx_.max_rotations);
     if (line && can_turn) {
@@ -211,6 +213,9 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
     const double lever = (c - n.s_A).norm();
     if (!n.local_rotation && dz > 1e-3 * lever) rq.limit_ccw = 0;
     if (!n.local_rotation && dz < -1e-3 * lever) rq.limit_cw = 0;
+    // Neutral (the centre of mass above the axis: a cylinder on its side, a ball): after the
+    // first turn of a tree only one way is followed, so rolling costs a path, not a tree.
+    if (!n.local_rotation && std::abs(dz) <= 1e-3 * lever && n.turns > 0) rq.limit_cw = 0;
     // Directions a contact blocks, or not asked for, are not searched (limit 0).
     if (blocked(n.contacts, n.s_A, n.d_A, 1, 1.5 * ctx_.cd)) rq.limit_ccw = 0;
     if (!n.both_directions || blocked(n.contacts, n.s_A, n.d_A, -1, 1.5 * ctx_.cd)) rq.limit_cw = 0;

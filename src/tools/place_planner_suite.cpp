@@ -45,7 +45,9 @@ double median(std::vector<double> v) {
   std::fprintf(stderr,
                "%s\nusage: place_planner_suite --data DIR --out DIR [--plots DIR] [--pairs S,...]\n"
                "  [--holes 0.05,0.1,0.2|none] [--no-fig6] [--max-validated N] [--max-drops N]\n"
-               "  [--threads N] [--friction MU] [--auto-gravity]\n"
+               "  [--threads N] [--friction MU] [--auto-gravity] [--orientation MODE]\n"
+               "  [--robust-shift M] [--robust-tilt-deg D] [--robust-com-offset F] [--robust-min-share S]\n"
+               "  [--no-robust-check]\n"
                "  --auto-gravity: areas with under 5 %% of their surface facing up are planned and\n"
                "  validated with gravity against their largest flat region (area_up.h)\n",
                msg);
@@ -122,6 +124,13 @@ int main(int argc, char** argv) {
     else if (a == "--threads") cfg.planner.threads = std::stoi(next());
     else if (a == "--friction") cfg.planner.friction = std::stod(next());
     else if (a == "--auto-gravity") cfg.auto_gravity = true;
+    // Planner options, to measure their effect on precision and coverage (issue 9).
+    else if (a == "--orientation") cfg.planner.orientation = orientationModeFromString(next());
+    else if (a == "--robust-shift") cfg.planner.robust_shift = std::stod(next());
+    else if (a == "--robust-tilt-deg") cfg.planner.robust_tilt_deg = std::stod(next());
+    else if (a == "--robust-com-offset") cfg.planner.robust_com_offset = std::stod(next());
+    else if (a == "--robust-min-share") cfg.planner.robust_min_share = std::stod(next());
+    else if (a == "--no-robust-check") cfg.planner.robust_check = false;
     else usage(("unknown argument " + a).c_str());
   }
   if (out.empty()) usage("--out is required");

@@ -190,6 +190,7 @@ TEST(Robustness, BoxNearTheEdgeOfAWallTop) {
   p.shift = 0;
   p.tilt = 0;
   p.com_offset = 0;
+  p.min_share = 0;  // settle every trial (no early decision) to count them
   const Robustness exact = checkRobustness({X_GO}, ctx, p).front();
   EXPECT_EQ(exact.trials, 12);
   EXPECT_EQ(exact.held, 12) << "stable at delta = 0";
@@ -198,6 +199,9 @@ TEST(Robustness, BoxNearTheEdgeOfAWallTop) {
   EXPECT_LT(shifted.held, 12) << "a 3 mm shift over the edge must fall";
   // The shifts along the wall (y) and away from the edge (-x) hold.
   EXPECT_GE(shifted.held, 11);
+  // Decided early (every trial must hold): the first failure ends the pose's other trials.
+  p.min_share = 1;
+  EXPECT_LT(checkRobustness({X_GO}, ctx, p).front().held, 12);
 }
 
 TEST(Stability, WedgeNeedsSqueezeAndIsNotStable) {

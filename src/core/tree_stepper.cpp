@@ -216,6 +216,18 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
     // Neutral (the centre of mass above the axis: a cylinder on its side, a ball): after the
     // first turn of a tree only one way is followed, so rolling costs a path, not a tree.
     if (!n.local_rotation && std::abs(dz) <= 1e-3 * lever && n.turns > 0) rq.limit_cw = 0;
+    // A tilt ends where gravity can no longer carry it about this axis: once the centre of
+    // mass has dropped below the axis (its lever past horizontal) the object slides or falls off
+    // the pivot rather than keep turning on it. So the search covers the lever's elevation plus
+    // 20 degrees (at least the paper's 60): an object on its end tips over until it lies (90),
+    // one hanging over an edge is not turned round it to the side of a box.
+    const Eigen::Vector3d lev = (c - n.s_A) - (c - n.s_A).dot(n.d_A) * n.d_A;
+    const double elevation = lev.norm() > 1e-9 ? std::asin(std::clamp(lev.z() / lev.norm(), -1.0, 1.0)) : 0.0;
+    const double reach = std::clamp(elevation + 20.0 * M_PI / 180.0, 60.0 * M_PI / 180.0, M_PI);
+    if (!n.local_rotation) {
+      rq.limit_ccw = std::min(rq.limit_ccw, reach);
+      rq.limit_cw = std::min(rq.limit_cw, reach);
+    }
     // Directions a contact blocks, or not asked for, are not searched (limit 0).
     if (blocked(n.contacts, n.s_A, n.d_A, 1, 1.5 * ctx_.cd)) rq.limit_ccw = 0;
     if (!n.both_directions || blocked(n.contacts, n.s_A, n.d_A, -1, 1.5 * ctx_.cd)) rq.limit_cw = 0;

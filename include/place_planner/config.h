@@ -32,7 +32,7 @@ struct PlannerConfig {
   // Robust stability (robustness.cpp): a stable pose must also hold when released off it.
   double robust_shift = 0.003;               // m, horizontal release offset delta
   double robust_tilt_deg = 3.0;              // release tilt epsilon
-  double robust_com_offset = 0.05;           // centre of mass off by this share of the object's size
+  double robust_com_offset = 0.05;           // centre of mass off by this share of the object's extent along x, y
   double robust_min_share = 1.0;             // share of perturbed releases that must hold
   bool robust_check = true;                  // false: static stability only (the paper)
   double time_budget_ms = 0.0;               // 0 = no budget

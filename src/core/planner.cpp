@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <future>
 #include <mutex>
 
@@ -97,6 +98,85 @@ std::vector<V3> findFloorPoints(const AreaModel& am, const PlannerConfig& config
   return orderFloorPoints(kept, fp.spacing);
 }
 
+// What the tree steps need (Sections V, VI): models, backend, stability parameters.
+TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaModel& am, Backend& backend,
+                        const Radii& rad, const PlannerConfig& config, PlanStats& st) {
+  // Support at least min_support_width wide, or a quarter of the object's middle extent.
+  Eigen::Vector3d ext = object.properties.bounds_max - object.properties.bounds_min;
+  std::sort(ext.data(), ext.data() + 3);
+  const StabilityParams sp{config.friction, 1.5 * rad.cd, config.min_tipping_angle_deg * M_PI / 180.0,
+                           std::min(config.min_support_width, 0.25 * ext[1])};
+  return TreeContext{om, am, backend, sp, rad.cd, config.max_rotations, config.max_local_optimisation_steps,
+                     config.threads, &st.steps, &st.tree_nodes};
+}
+
+RobustnessParams robustnessParams(const PlannerConfig& config) {
+  RobustnessParams rp;
+  rp.shift = config.robust_shift;
+  rp.tilt = config.robust_tilt_deg * M_PI / 180.0;
+  rp.com_offset = config.robust_com_offset;
+  rp.min_share = config.robust_min_share;
+  return rp;
+}
+
+// The search's bookkeeping between batched steps: the penetration guard, the first robust
+// stable pose (each new stable leaf is checked at once until one holds), progress, budget.
+struct SearchMonitor {
+  const ObjectModel& om;
+  const AreaModel& am;
+  const PlannerConfig& config;
+  const ProgressCallback& progress;
+  Clock::time_point t0;
+  double search_budget, penetration_limit;
+  int orientations;
+  std::function<std::vector<Robustness>(const std::vector<size_t>&)> robustness;
+  PlanResult& result;
+  std::vector<std::pair<size_t, Robustness>> checked;  // leaf index, its robustness
+  size_t seen = 0;
+  double best_q = 0;
+  int stable_count = 0;
+
+  bool afterStep(std::vector<TreeLeaf>& all, int started, int open) {
+    PlanStats& st = result.stats;
+    for (; seen < all.size(); ++seen) {
+      TreeLeaf& l = all[seen];
+      // Penetration guard: an object inside the area by more than a sphere radius is not stable.
+      if (l.stable && penetrationDepth(om, am, l.X_GO) > penetration_limit) l.stable = false;
+      if (!l.stable) continue;
+      if (st.first_stable_ms < 0 && config.robust_check) {
+        const Robustness r = robustness({seen}).front();
+        checked.emplace_back(seen, r);
+        if (r.share() < config.robust_min_share - 1e-9) continue;
+      }
+      if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);
+      ++stable_count;
+      best_q = std::max(best_q, l.quality);
+    }
+    st.floor_points_done = (started - open) / std::max(1, orientations);
+    if (search_budget > 0 && msSince(t0) > search_budget) return !(result.timed_out = true);
+    if (!progress) return true;
+    const Progress p{st.floor_points_done, st.floor_points_total, best_q, stable_count, msSince(t0)};
+    if (!progress(p)) return !(result.cancelled = true);
+    return true;
+  }
+
+  // Robustness for the ranking: what the search checked already, the rest now.
+  std::vector<Robustness> robustnessOf(const std::vector<size_t>& idx) {
+    std::vector<Robustness> out(idx.size());
+    std::vector<size_t> todo, where;
+    for (size_t j = 0; j < idx.size(); ++j) {
+      auto it = std::find_if(checked.begin(), checked.end(), [&](const auto& c) { return c.first == idx[j]; });
+      if (it != checked.end()) out[j] = it->second;
+      else todo.push_back(idx[j]), where.push_back(j);
+    }
+    if (!todo.empty()) {
+      const auto rs = robustness(todo);
+      for (size_t j = 0; j < where.size(); ++j) out[where[j]] = rs[j];
+    }
+    return out;
+  }
+};
+
 }  // namespace
 
 Planner::Planner() : cache_(std::make_shared<AreaModelCache>()) {}
@@ -112,7 +192,6 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   PlanResult result;
   PlanStats& st = result.stats;
   const double budget = config.time_budget_ms;
-  const double search_budget = budget * (config.robust_check ? kSearchShareOfBudget : 1.0);
 
   // ---- models (III, V-B): the object's built while the area's is built or fetched
   const Eigen::Vector3d d_g_W = config.gravity.normalized();
@@ -143,19 +222,10 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   st.roots_total = roots.size();
 
   // ---- the trees of rotations (V, VI), every pending pose batched (VII-C)
-  Eigen::Vector3d ext = object.properties.bounds_max - object.properties.bounds_min;
-  std::sort(ext.data(), ext.data() + 3);
-  TreeContext ctx{om, am, *backend,
-                  StabilityParams{config.friction, 1.5 * rad.cd, config.min_tipping_angle_deg * M_PI / 180.0,
-                                  std::min(config.min_support_width, 0.25 * ext[1])},
-                  rad.cd, config.max_rotations, config.max_local_optimisation_steps, config.threads,
-                  &st.steps, &st.tree_nodes};
-  RobustnessParams rp;
-  rp.shift = config.robust_shift;
-  rp.tilt = config.robust_tilt_deg * M_PI / 180.0;
-  rp.com_offset = config.robust_com_offset;
-  rp.min_share = config.robust_min_share;
-  auto robustness = [&](const std::vector<size_t>& idx, const std::vector<TreeLeaf>& leaves) {
+  const TreeContext ctx = treeContext(object, om, am, *backend, rad, config, st);
+  const RobustnessParams rp = robustnessParams(config);
+  std::vector<TreeLeaf> leaves;
+  auto robustness = [&](const std::vector<size_t>& idx) {  // robust stability, beyond the paper
     const auto tr = Clock::now();
     std::vector<Rigid> X;
     for (size_t i : idx) X.push_back(leaves[i].X_GO);
@@ -163,39 +233,16 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     st.robustness_ms += msSince(tr);
     return out;
   };
-  std::vector<TreeLeaf> leaves;
-  std::vector<std::pair<size_t, Robustness>> checked;  // during the search (first robust pose)
-  size_t seen = 0;
-  double best_q = 0;
-  int stable_count = 0;
+  // With the robustness check on, the search leaves a share of the budget for it.
+  SearchMonitor monitor{om, am, config, progress, t0,
+                        budget * (config.robust_check ? kSearchShareOfBudget : 1.0), rad.r,
+                        static_cast<int>(orientations.size()), robustness, result};
   TreeStepper stepper(ctx);
-  auto after_step = [&](int started, int open) {
-    for (; seen < leaves.size(); ++seen) {
-      TreeLeaf& l = leaves[seen];
-      // Penetration guard: an object inside the area by more than a sphere radius is not stable.
-      if (l.stable && penetrationDepth(om, am, l.X_GO) > rad.r) l.stable = false;
-      if (!l.stable) continue;
-      // Until one holds, each new stable leaf is checked at once: the first robust pose's time.
-      if (st.first_stable_ms < 0 && config.robust_check) {
-        const Robustness r = robustness({seen}, leaves).front();
-        checked.emplace_back(seen, r);
-        if (r.share() < config.robust_min_share - 1e-9) continue;
-      }
-      if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);
-      ++stable_count;
-      best_q = std::max(best_q, l.quality);
-    }
-    st.floor_points_done = (started - open) / std::max<int>(1, orientations.size());
-    if (search_budget > 0 && msSince(t0) > search_budget) return !(result.timed_out = true);
-    if (!progress) return true;
-    const Progress p{st.floor_points_done, st.floor_points_total, best_q, stable_count, msSince(t0)};
-    if (!progress(p)) return !(result.cancelled = true);
-    return true;
-  };
-  streamRoots(roots, stepper, om.com, std::max(16, 12 * resolveThreads(config.threads)), leaves, after_step);
+  streamRoots(roots, stepper, om.com, std::max(16, 12 * resolveThreads(config.threads)), leaves,
+              [&](int started, int open) { return monitor.afterStep(leaves, started, open); });
   for (const TreeLeaf& l : leaves) st.trees_without_rest += !l.at_rest;
 
-  // ---- robustness and ranking (VI's Q, robust stability, re-orientation)
+  // ---- ranking (VI's Q, robust stability, re-orientation)
   std::vector<StartKind> kinds(roots.size());
   std::vector<Eigen::Vector3d> floor_W(roots.size());
   for (int k = 0; k < roots.size(); ++k) {
@@ -203,20 +250,8 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     floor_W[k] = result.floor_points_W[roots.floorPoint(k)];
   }
   const RankingInput in{leaves, kinds, floor_W, am.R_GW, R_held_G, object.properties.bounding_radius};
-  result.candidates = rankCandidates(in, config, [&](const std::vector<size_t>& idx) {
-    std::vector<Robustness> out(idx.size());
-    std::vector<size_t> todo, where;
-    for (size_t j = 0; j < idx.size(); ++j) {
-      auto it = std::find_if(checked.begin(), checked.end(), [&](const auto& c) { return c.first == idx[j]; });
-      if (it != checked.end()) out[j] = it->second;
-      else todo.push_back(idx[j]), where.push_back(j);
-    }
-    if (!todo.empty()) {
-      const auto rs = robustness(todo, leaves);
-      for (size_t j = 0; j < where.size(); ++j) out[where[j]] = rs[j];
-    }
-    return out;
-  }, &st);
+  result.candidates = rankCandidates(
+      in, config, [&](const std::vector<size_t>& idx) { return monitor.robustnessOf(idx); }, &st);
   if (budget > 0 && msSince(t0) > budget) result.timed_out = true;
   st.total_ms = msSince(t0);
   return result;

@@ -87,4 +87,8 @@ inline Eigen::Vector3d toEigen(V3 p) { return Eigen::Vector3d(p.x, p.y, p.z); }
 Rigid toRigid(const Eigen::Isometry3d& T);
 Eigen::Isometry3d toIsometry(const Rigid& T);
 
+// Angle (rad) of the rotation between two orientations (host only: scene.cpp).
+double rotationAngle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
+double rotationAngle(const Rigid& a, const Rigid& b);
+
 }  // namespace place_planner

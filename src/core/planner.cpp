@@ -236,7 +236,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // With the robustness check on, the search leaves a share of the budget for it.
   SearchMonitor monitor{om, am, config, progress, t0,
                         budget * (config.robust_check ? kSearchShareOfBudget : 1.0), rad.r,
-                        static_cast<int>(orientations.size()), robustness, result};
+                        static_cast<int>(orientations.size()), robustness, result, {}, 0, 0.0, 0};
   TreeStepper stepper(ctx);
   streamRoots(roots, stepper, om.com, std::max(16, 12 * resolveThreads(config.threads)), leaves,
               [&](int started, int open) { return monitor.afterStep(leaves, started, open); });

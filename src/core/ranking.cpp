@@ -9,10 +9,6 @@
 namespace place_planner {
 namespace {
 
-double angleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return Eigen::AngleAxisd(a.transpose() * b).angle();
-}
-
 struct Item {
   size_t leaf;
   bool stable;
@@ -56,24 +52,25 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     const TreeLeaf& l = leaves[i];
     if (l.quality < config.min_quality) continue;
     items.push_back({i, l.stable, l.quality,
-                     angleBetween(in.R_held_G, toIsometry(l.X_GO).linear()), {}, false});
+                     rotationAngle(in.R_held_G, toIsometry(l.X_GO).linear()), {}, false});
   }
   sortItems(items, leaves);
   // Merge: a pose near a better one is the same candidate (G and W differ by a rotation only).
   const double merge_angle = config.merge_angle_deg * M_PI / 180.0;
   std::vector<Item> distinct;
+  std::vector<Eigen::Isometry3d> kept;  // poses of `distinct`, converted once
   for (const Item& it : items) {
     const Eigen::Isometry3d X = toIsometry(leaves[it.leaf].X_GO);
     bool dup = false;
-    for (const Item& k : distinct) {
-      const Eigen::Isometry3d Y = toIsometry(leaves[k.leaf].X_GO);
+    for (const Eigen::Isometry3d& Y : kept)
       if ((X.translation() - Y.translation()).norm() < config.merge_distance &&
-          angleBetween(X.linear(), Y.linear()) < merge_angle) {
+          rotationAngle(X.linear(), Y.linear()) < merge_angle) {
         dup = true;
         break;
       }
-    }
-    if (!dup) distinct.push_back(it);
+    if (dup) continue;
+    distinct.push_back(it);
+    kept.push_back(X);
   }
   // Robustness, best stable first, until max_candidates robust ones are found.
   if (config.robust_check && check) {

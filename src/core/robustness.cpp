@@ -4,8 +4,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 namespace place_planner {
 namespace {
@@ -19,7 +17,19 @@ struct Trial {
 
 // Trial k of pose X: 0-3 shifted by delta along +-x, +-y; 4-7 tilted by epsilon about +-x,
 // +-y through the centre of mass; 8-11 with the centre of mass moved along +-x, +-y (G).
-Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const RobustnessParams& p) {
+// The posed object's extent along x and y of G.
+Eigen::Vector2d horizontalExtent(const Rigid& X, const ObjectModel& om) {
+  Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
+  for (const V3& v : om.vertices) {
+    const V3 q = apply(X, v);
+    lo = lo.cwiseMin(Eigen::Vector2d(q.x, q.y));
+    hi = hi.cwiseMax(Eigen::Vector2d(q.x, q.y));
+  }
+  return hi - lo;
+}
+
+Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const Eigen::Vector2d& extent,
+                const RobustnessParams& p) {
   const Eigen::Vector3d dirs[4] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
   const Eigen::Vector3d d = dirs[k % 4];
   Trial t{X, om.com};
@@ -35,20 +45,11 @@ Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const RobustnessPa
   } else {
     // The centre of mass off horizontally (G) by com_offset times the object's extent along
     // that direction (a slender object's error is slender too), expressed in O.
-    double lo = kInf, hi = -kInf;
-    for (const V3& v : om.vertices) {
-      const double x = dot(apply(X, v), toV3(d));
-      lo = std::min(lo, x);
-      hi = std::max(hi, x);
-    }
-    t.com_O = om.com + rotateInv(X, toV3(p.com_offset * (hi - lo) * d));
+    const double along = d.x() != 0 ? extent.x() : extent.y();
+    t.com_O = om.com + rotateInv(X, toV3(p.com_offset * along * d));
   }
   t.X_start.t = t.X_start.t + v3(0, 0, lift);
   return t;
-}
-
-double angleBetween(const Rigid& a, const Rigid& b) {
-  return Eigen::AngleAxisd(toIsometry(a).linear().transpose() * toIsometry(b).linear()).angle();
 }
 
 }  // namespace
@@ -61,12 +62,14 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
   ctx.times = nullptr;  // the caller times the whole check
   TreeStepper stepper(ctx);
   const ObjectModel& om = ctx.om;
-  for (size_t i = 0; i < X_GO.size(); ++i)
+  for (size_t i = 0; i < X_GO.size(); ++i) {
+    const Eigen::Vector2d extent = horizontalExtent(X_GO[i], om);
     for (int k = 0; k < kTrials; ++k) {
-      const Trial t = makeTrial(X_GO[i], k, om, p);
+      const Trial t = makeTrial(X_GO[i], k, om, extent, p);
       const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
       stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax);
     }
+  }
   // A trial holds when it ended (all its leaves: a tree may branch) near the pose, stable or
   // statically supported (centre of mass inside its support with the tipping margin: a release
   // that settles a fraction of a degree off flat has a partial contact band).
@@ -77,7 +80,7 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
   const int allowed = static_cast<int>(std::floor((1.0 - p.min_share) * kTrials + 1e-9));
   auto near = [&](const Rigid& X, size_t i, double scale) {
     const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(X, om.com));
-    return (c1 - c0).norm() <= scale * p.end_distance && angleBetween(X, X_GO[i]) <= scale * p.end_angle;
+    return (c1 - c0).norm() <= scale * p.end_distance && rotationAngle(X, X_GO[i]) <= scale * p.end_angle;
   };
   auto fail = [&](int trial) {
     if (state[trial] != -1) ++failures[trial / kTrials];
@@ -111,10 +114,8 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
   // Trials cut by the caller fail.
   if (!finished)
     for (int r : stepper.openRoots()) fail(r);
-  std::vector<char> has_leaf(state.size(), 0);
-  for (size_t k = 0; k < state.size(); ++k) has_leaf[k] = state[k] != 0;
-  for (size_t k = 0; k < state.size(); ++k)
-    if (!has_leaf[k]) state[k] = -1;  // the tree vanished (fell off the area)
+  for (int& st : state)
+    if (st == 0) st = -1;  // no leaf: the tree vanished (fell off the area)
   std::vector<Robustness> out(X_GO.size());
   for (size_t i = 0; i < X_GO.size(); ++i) {
     Robustness& r = out[i];

@@ -185,4 +185,12 @@ AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, d
   return a;
 }
 
+double rotationAngle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a.transpose() * b).angle();
+}
+
+double rotationAngle(const Rigid& a, const Rigid& b) {
+  return rotationAngle(toIsometry(a).linear(), toIsometry(b).linear());
+}
+
 }  // namespace place_planner

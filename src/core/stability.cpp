@@ -11,6 +11,23 @@ namespace {
 
 const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();  // -d_g in G
 
+// Least-squares plane of points: their centroid and the eigen decomposition of their scatter
+// (smallest eigenvector first: the normal).
+struct PlaneFit {
+  Eigen::Vector3d centroid;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+};
+PlaneFit fitPlane(const std::vector<Eigen::Vector3d>& pts) {
+  PlaneFit f;
+  f.centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : pts) f.centroid += p;
+  f.centroid /= static_cast<double>(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : pts) cov += (p - f.centroid) * (p - f.centroid).transpose();
+  f.eigen.compute(cov);
+  return f;
+}
+
 // 2D analysis of a support polygon in the plane through `origin` with normal `n` (unit),
 // centre of mass projected along gravity (-z).
 struct Support {
@@ -215,22 +232,19 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   if (contacts.empty()) return r;
   const double cone = std::atan(prm.friction);
   // ---------------------------------------------------------------- planar case
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const auto& p : contacts) c += p.p_W;
-  c /= static_cast<double>(contacts.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const auto& p : contacts) cov += (p.p_W - c) * (p.p_W - c).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  std::vector<Eigen::Vector3d> pts;
+  for (const auto& p : contacts) pts.push_back(p.p_W);
+  const PlaneFit fit = fitPlane(pts);
+  const Eigen::Vector3d& c = fit.centroid;
+  const auto& es = fit.eigen;
   Eigen::Vector3d n = es.eigenvectors().col(0).normalized();
   if (n.dot(kUp) < 0) n = -n;
   double off = 0, spread2 = 0;
   const Eigen::Vector3d second = es.eigenvectors().col(1).normalized();
-  for (const auto& p : contacts) {
-    off = std::max(off, std::abs((p.p_W - c).dot(n)));
-    spread2 = std::max(spread2, std::abs((p.p_W - c).dot(second)));
+  for (const auto& p : pts) {
+    off = std::max(off, std::abs((p - c).dot(n)));
+    spread2 = std::max(spread2, std::abs((p - c).dot(second)));
   }
-  std::vector<Eigen::Vector3d> pts;
-  for (const auto& p : contacts) pts.push_back(p.p_W);
   // Planar: on one plane and spanning it (contacts on a line lie on every plane through it).
   // The contacts must push the object up: their mean normal (pointing at the object) against
   // gravity. Contacts from above (an object pressed under a table) never support it.
@@ -314,12 +328,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
         const Support s2 = analyse2(support, df, com);
         // Omega'' must face d'_f or the floor within the friction angle (the paper's test):
         // the normal of the plane through its contacts.
-        Eigen::Vector3d cs = Eigen::Vector3d::Zero();
-        for (const auto& p : support) cs += p;
-        cs /= static_cast<double>(support.size());
-        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-        for (const auto& p : support) cov += (p - cs) * (p - cs).transpose();
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es2(cov);
+        const auto& es2 = fitPlane(support).eigen;
         const Eigen::Vector3d n2 = es2.eigenvectors().col(0);
         const bool spans = es2.eigenvalues()(1) > prm.tol * prm.tol;
         const double to_df = std::acos(std::min(1.0, std::abs(n2.dot(df))));

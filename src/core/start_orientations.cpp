@@ -16,10 +16,6 @@ namespace {
 constexpr double kMinRestingTipDeg = 10.0;
 constexpr double kDistinctDeg = 8.0;
 
-double angleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return Eigen::AngleAxisd(a.transpose() * b).angle();
-}
-
 // Angle about z of the object's longest horizontal extent (2D principal axis of its vertices
 // in G) and its elongation (ratio of the two spreads).
 std::pair<double, double> horizontalAxis(const Mesh& object, const Eigen::Matrix3d& R) {
@@ -88,7 +84,7 @@ std::vector<StartOrientation> startOrientations(const Mesh& object, const Eigen:
   std::vector<StartOrientation> out;
   auto add = [&](const Eigen::Matrix3d& R, StartKind kind) {
     for (const auto& s : out)
-      if (angleBetween(s.R_GO, R) < kDistinctDeg * M_PI / 180.0) return;
+      if (rotationAngle(s.R_GO, R) < kDistinctDeg * M_PI / 180.0) return;
     out.push_back({R, kind});
   };
   if (config.orientation != OrientationMode::kAuto) {

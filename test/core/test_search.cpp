@@ -168,8 +168,16 @@ TEST(Search, ApproachAgainstGravityFindsNothingBelowTheTable) {
   const PlanResult r = Planner().plan(cube, table, cfg);
   EXPECT_GT(r.stats.tree_nodes, 0);
   const double top = table.properties.bounds_max.z();
-  for (const auto& c : r.candidates)
+  ASSERT_FALSE(r.candidates.empty()) << "no tree reached a leaf: the test would pass on nothing";
+  int below = 0;
+  for (const auto& c : r.candidates) {
+    below += (c.X_WO * cube.properties.center_of_mass).z() < top;
     if (c.stable) EXPECT_GT((c.X_WO * cube.properties.center_of_mass).z(), top) << "stable under the table";
+  }
+  EXPECT_GT(below, 0) << "the trees did reach the underside";
+  // The same scene approached from above has stable poses: the check can tell them apart.
+  cfg.approach = Eigen::Vector3d::Zero();
+  EXPECT_GT(Planner().plan(cube, table, cfg).stableCount(), 0);
 }
 
 // ------------------------------------------------------------------ robust stability

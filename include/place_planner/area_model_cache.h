@@ -20,10 +20,16 @@ class AreaModelCache {
  public:
   explicit AreaModelCache(size_t capacity = 4) : capacity_(capacity) {}
   // The model of `area_W` for these parameters: from the cache when an entry has the same key
-  // and the same mesh and parameters (checked, not only hashed), else built and kept.
+  // and the same mesh and parameters (checked, not only hashed), else built and kept. A mesh
+  // over max_triangles is decimated first (work_limits.h; the model says so). `stop` may
+  // interrupt the build (Stopped; nothing is kept).
   std::shared_ptr<const AreaModel> get(const Mesh& area_W, const Eigen::Vector3d& gravity_W,
                                        double sphere_radius, double collision_distance,
-                                       double grid_cell);
+                                       double grid_cell, size_t max_triangles = static_cast<size_t>(-1),
+                                       const StopSignal* stop = nullptr);
+  // Whether get() with these arguments would be answered from the cache.
+  bool contains(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
+                double collision_distance, double grid_cell, size_t max_triangles = static_cast<size_t>(-1)) const;
   void clear();
   size_t size() const;
 
@@ -34,11 +40,14 @@ class AreaModelCache {
     std::vector<std::array<int, 3>> triangles;
     Eigen::Vector3d gravity;
     double r, cd, cell;
+    size_t max_triangles;
     std::shared_ptr<const AreaModel> model;
   };
   size_t capacity_;
   mutable std::mutex mutex_;
   std::vector<Entry> entries_;  // oldest first
+  std::shared_ptr<const AreaModel> find(uint64_t key, const Mesh& area, const Eigen::Vector3d& g, double r,
+                                        double cd, double cell, size_t max_triangles) const;
 };
 
 }  // namespace place_planner

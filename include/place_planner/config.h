@@ -47,6 +47,14 @@ struct PlannerConfig {
   double merge_distance = 0.005;             // m, poses closer than this ...
   double merge_angle_deg = 3.0;              // ... and this are one candidate
   BackendKind backend = BackendKind::kAuto;  // kAuto: CUDA when a GPU is usable, else CPU
+  // Bounded work (work_limits.h), each checked before the work it bounds. Generous: the
+  // paper's workload is 1k triangles, 140 floor points, ~30k tree nodes, ~20 MB of models.
+  int max_triangles = 300000;                // per mesh; a larger one is decimated (a warning says so)
+  int max_floor_points = 5000;               // rays cast; a finer spacing is coarsened (a warning)
+  long max_tree_nodes = 3000000;             // poses evaluated; the search stops there (a warning)
+  double max_model_mb = 2000;                // estimated memory of both models; above: LimitError
+  double max_object_size = 3.0;              // m across; above: LimitError naming the unit (mm?)
+  double max_area_size = 100.0;              // m across; above: LimitError
   // Optional region (planning frame) the floor points must lie in; inactive when min > max.
   Eigen::Vector3d region_min{1.0, 1.0, 1.0};
   Eigen::Vector3d region_max{-1.0, -1.0, -1.0};

@@ -21,7 +21,11 @@ class MeshError : public std::invalid_argument {
 struct MeshBuildReport {
   int dropped_zero_area = 0;   // degenerate polygons/triangles removed
   int split_polygons = 0;      // non-planar or non-convex polygons split into triangles
+  int fanned_polygons = 0;     // ... of them self-intersecting: what ear clipping left is a fan
 };
+
+// Polygons with more vertices are rejected (MeshError): ear clipping costs about n^2.
+constexpr size_t kMaxPolygonVertices = 10000;
 
 // Derived properties (Section III). Frame: the mesh's own frame.
 struct MeshProperties {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "place_planner/mesh.h"
+#include "place_planner/stop_signal.h"
 
 namespace place_planner {
 
@@ -18,7 +19,7 @@ struct ConvexHull3 {
 // Incremental convex hull. Points inside the hull of their extremes along 26 directions are
 // dropped first (Akl-Toussaint), so a 16k-vertex scan costs a few ms. Fewer than 4 points
 // off one plane give an empty hull.
-ConvexHull3 convexHull3d(const std::vector<Eigen::Vector3d>& points);
+ConvexHull3 convexHull3d(const std::vector<Eigen::Vector3d>& points, const StopSignal* stop = nullptr);
 
 struct RestingFace {
   Eigen::Vector3d normal_O;          // outward normal of the facet: it points along gravity at rest
@@ -31,6 +32,6 @@ struct RestingFace {
 // inside with at least `min_tipping_angle` (rad) to spare, best margin first: what trimesh's
 // compute_stable_poses and Dex-Net rank for a plane. A ball has none.
 std::vector<RestingFace> restingFaces(const Mesh& object, double min_tipping_angle,
-                                      double merge_deg = 4.0);
+                                      double merge_deg = 4.0, const StopSignal* stop = nullptr);
 
 }  // namespace place_planner

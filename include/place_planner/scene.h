@@ -10,6 +10,7 @@
 
 #include "place_planner/bvh.h"
 #include "place_planner/mesh.h"
+#include "place_planner/stop_signal.h"
 
 namespace place_planner {
 
@@ -52,6 +53,8 @@ struct AreaModel : MeshModel {  // frame G
   HeightGrid grid;
   Eigen::Matrix3d R_GW;  // rotation from the planning frame W into G
   double up_facing_share = 1.0;  // of the surface, facing against gravity (area_up.h)
+  size_t source_triangles = 0;   // of the mesh given; more than triangles.size() when decimated
+  double decimation_cell = 0.0;  // m, cluster size of the decimation (0: none)
 };
 
 // Edges for the edge/edge tests: all but those between two (nearly) coplanar triangles. A
@@ -60,24 +63,27 @@ struct AreaModel : MeshModel {  // frame G
 // borders can meet as edge against edge. flat_deg bounds the dihedral angle called flat.
 // On a closed, consistently wound mesh (a solid) valley edges are dropped too: a crossing
 // contact needs both edges to be ridges (see scene.cpp); open sheets keep both kinds.
-std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg = 2.0);
+std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg = 2.0,
+                                             const StopSignal* stop = nullptr);
 
+// `stop` (may be null) interrupts the builds below with Stopped (stop_signal.h).
 // index_spheres(spheres, bounds) builds the index of the sphere model (the object's BVH, the
 // area's height grid); it runs on the thread that samples the spheres, beside the BVH builds.
 using SphereIndexer = std::function<void(SphereModel&, const Aabb&)>;
 MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius,
-                         const SphereIndexer& index_spheres = {});
-ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius);
+                         const SphereIndexer& index_spheres = {}, const StopSignal* stop = nullptr);
+ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius, const StopSignal* stop = nullptr);
 AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
-                         double collision_distance, double grid_cell);
+                         double collision_distance, double grid_cell, const StopSignal* stop = nullptr);
 
 // Samples sphere centres 2r apart on each triangle, its edges and vertices (sphere_model.cpp).
 SphereModel sampleSpheres(const std::vector<V3>& vertices,
                           const std::vector<std::array<int, 3>>& triangles,
-                          const std::vector<std::array<int, 2>>& edges, double radius);
+                          const std::vector<std::array<int, 2>>& edges, double radius,
+                          const StopSignal* stop = nullptr);
 
 HeightGrid buildHeightGrid(const SphereModel& area_spheres, const Aabb& area_bounds,
-                           double collision_distance, double cell);
+                           double collision_distance, double cell, const StopSignal* stop = nullptr);
 
 // Rotation taking -gravity to +z (the G frame), with a deterministic choice about z.
 Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W);

@@ -28,6 +28,7 @@ std::optional<double> areaWallDirection(const AreaModel& area);
 // The other modes are the paper's (pre_orientation.h).
 std::vector<StartOrientation> startOrientations(const Mesh& object, const Eigen::Matrix3d& R_held_G,
                                                 const Eigen::Vector3d& d_vis_G,
-                                                const AreaModel& area, const PlannerConfig& config);
+                                                const AreaModel& area, const PlannerConfig& config,
+                                                const StopSignal* stop = nullptr);
 
 }  // namespace place_planner

@@ -68,6 +68,18 @@ void validate(const PlannerConfig& c) {
           "robust_com_offset", c.robust_com_offset, "0 .. 0.3 (share of the object's size)");
   require(std::isfinite(c.robust_min_share) && c.robust_min_share >= 0 && c.robust_min_share <= 1,
           "robust_min_share", c.robust_min_share, "0 .. 1");
+  require(c.max_triangles >= 100 && c.max_triangles <= 50000000, "max_triangles", c.max_triangles,
+          "100 .. 50000000");
+  require(c.max_floor_points >= 1 && c.max_floor_points <= 1000000, "max_floor_points",
+          c.max_floor_points, "1 .. 1000000");
+  require(c.min_floor_points <= c.max_floor_points, "min_floor_points", c.min_floor_points,
+          "<= max_floor_points");
+  require(c.max_tree_nodes >= 100, "max_tree_nodes", c.max_tree_nodes, ">= 100");
+  require(std::isfinite(c.max_model_mb) && c.max_model_mb >= 1, "max_model_mb", c.max_model_mb, ">= 1 MB");
+  require(std::isfinite(c.max_object_size) && c.max_object_size > 0, "max_object_size",
+          c.max_object_size, "> 0 m");
+  require(std::isfinite(c.max_area_size) && c.max_area_size > 0, "max_area_size", c.max_area_size,
+          "> 0 m");
   require(std::isfinite(c.merge_angle_deg) && c.merge_angle_deg >= 0, "merge_angle_deg",
           c.merge_angle_deg, ">= 0");
 }

@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <sstream>
 
@@ -42,7 +43,7 @@ bool isPlanarConvex(const std::vector<Eigen::Vector3d>& v, const std::vector<int
 // Ear clipping in the plane of n_unit; returns triangles (indices into v).
 std::vector<std::array<int, 3>> earClip(const std::vector<Eigen::Vector3d>& v,
                                         const std::vector<int>& poly,
-                                        const Eigen::Vector3d& n_unit) {
+                                        const Eigen::Vector3d& n_unit, bool* fanned) {
   Eigen::Vector3d u = n_unit.unitOrthogonal();
   Eigen::Vector3d w = n_unit.cross(u);
   std::vector<Eigen::Vector2d> p(poly.size());
@@ -53,12 +54,13 @@ std::vector<std::array<int, 3>> earClip(const std::vector<Eigen::Vector3d>& v,
   std::vector<int> idx(poly.size());
   for (size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<int>(i);
   std::vector<std::array<int, 3>> tris;
-  int guard = 0;
-  while (idx.size() > 3 && guard < 10000) {
-    ++guard;
+  // Each pass clips one ear, searching on from the last one (ears cluster): about n^2 tests.
+  size_t from = 0;
+  while (idx.size() > 3) {
     bool clipped = false;
     const size_t m = idx.size();
-    for (size_t i = 0; i < m; ++i) {
+    for (size_t s = 0; s < m; ++s) {
+      const size_t i = (from + s) % m;
       const int a = idx[(i + m - 1) % m], b = idx[i], c = idx[(i + 1) % m];
       if (cross2(p[a], p[b], p[c]) <= 0) continue;  // reflex or degenerate corner
       bool inside = false;
@@ -71,11 +73,13 @@ std::vector<std::array<int, 3>> earClip(const std::vector<Eigen::Vector3d>& v,
       if (inside) continue;
       tris.push_back({poly[a], poly[b], poly[c]});
       idx.erase(idx.begin() + static_cast<long>(i));
+      from = i == 0 ? 0 : i - 1;
       clipped = true;
       break;
     }
-    if (!clipped) break;  // self-intersecting input: fall back to a fan for the rest
+    if (!clipped) break;  // self-intersecting: no ear is left; a fan for the rest (counted)
   }
+  *fanned = idx.size() > 3;
   for (size_t i = 1; i + 1 < idx.size(); ++i) tris.push_back({poly[idx[0]], poly[idx[i]], poly[idx[i + 1]]});
   return tris;
 }
@@ -100,10 +104,10 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
   }
   for (size_t f = 0; f < polygons.size(); ++f) {
     const auto& poly = polygons[f];
-    if (poly.size() < 3) {
+    if (poly.size() < 3 || poly.size() > kMaxPolygonVertices) {
       std::ostringstream os;
-      os << name << ": polygon " << f << " has " << poly.size()
-         << " vertices (at least 3 needed)";
+      os << name << ": polygon " << f << " has " << poly.size() << " vertices ("
+         << (poly.size() < 3 ? "at least 3 needed" : "at most 10000: triangulate it first") << ")";
       throw MeshError(os.str());
     }
     for (int idx : poly) {
@@ -152,7 +156,10 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
       continue;
     }
     ++m.report.split_polygons;
-    for (const auto& t : earClip(vertices, poly, n)) {
+    bool fanned = false;
+    const auto ears = earClip(vertices, poly, n, &fanned);
+    m.report.fanned_polygons += fanned;
+    for (const auto& t : ears) {
       std::vector<int> tri{t[0], t[1], t[2]};
       const Eigen::Vector3d tn = newellNormal(vertices, tri);
       if (tn.norm() <= area_tol) {
@@ -166,7 +173,8 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
     throw MeshError(name + ": no patch with non-zero area (all " + std::to_string(polygons.size()) +
                     " polygons are degenerate)");
 
-  std::map<std::pair<int, int>, int> edge_ids;
+  // Unique edges in the order of their first use: (key, first use) pairs sorted, one per key.
+  std::vector<std::pair<uint64_t, size_t>> uses;
   for (size_t f = 0; f < m.patches.size(); ++f) {
     const auto& poly = m.patches[f];
     for (size_t i = 1; i + 1 < poly.size(); ++i) {
@@ -176,10 +184,17 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
     for (size_t i = 0; i < poly.size(); ++i) {
       int a = poly[i], b = poly[(i + 1) % poly.size()];
       if (a > b) std::swap(a, b);
-      if (edge_ids.emplace(std::make_pair(a, b), static_cast<int>(m.edges.size())).second)
-        m.edges.push_back({a, b});
+      uses.emplace_back((static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b), uses.size());
     }
   }
+  std::sort(uses.begin(), uses.end());
+  std::vector<size_t> first;
+  for (size_t i = 0; i < uses.size(); ++i)
+    if (i == 0 || uses[i].first != uses[i - 1].first) first.push_back(i);
+  std::sort(first.begin(), first.end(), [&](size_t x, size_t y) { return uses[x].second < uses[y].second; });
+  m.edges.reserve(first.size());
+  for (size_t i : first)
+    m.edges.push_back({static_cast<int>(uses[i].first >> 32), static_cast<int>(uses[i].first & 0xffffffffu)});
   m.properties = computeProperties(m);
   return m;
 }

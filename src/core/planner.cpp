@@ -11,6 +11,7 @@
 #include <functional>
 #include <future>
 #include <mutex>
+#include <optional>
 
 #include "place_planner/area_model_cache.h"
 #include "place_planner/area_up.h"
@@ -23,6 +24,7 @@
 #include "place_planner/robustness.h"
 #include "place_planner/root_search.h"
 #include "place_planner/start_orientations.h"
+#include "place_planner/work_limits.h"
 
 namespace place_planner {
 namespace {
@@ -39,14 +41,16 @@ constexpr double kMinUpFacingShare = 0.05;
 constexpr double kSearchShareOfBudget = 0.8;
 
 // Sphere radii and the collision distance (Section V-B), from the object's size: about 1 % of
-// it within 0.75 .. 4 mm; the area's spheres coarser, in steps shared by similar objects.
+// it within 0.75 .. 4 mm (down to 5 % of it for objects under 15 mm); the area's spheres
+// coarser, in steps shared by similar objects.
 struct Radii {
   double r, r_area, cd, cell;
 };
 Radii sphereRadii(const Mesh& object, const PlannerConfig& config) {
   Radii s;
+  const double size = 2.0 * object.properties.bounding_radius;
   s.r = config.sphere_radius > 0 ? config.sphere_radius
-                                 : std::clamp(0.01 * 2.0 * object.properties.bounding_radius, 0.00075, 0.004);
+                                 : std::clamp(0.01 * size, std::max(1e-5, std::min(0.00075, 0.05 * size)), 0.004);
   s.r_area = areaSphereRadius(s.r);
   // The grid holds for every object radius of this step (up to r_area / 1.5).
   s.cd = s.r_area + s.r_area / 1.5;
@@ -81,13 +85,21 @@ void warnAboutGravity(const Mesh& area, const AreaModel& am, const Eigen::Vector
 }
 
 // Floor points (IV-B) in G, in the anytime order, restricted to the region when one is set.
-std::vector<V3> findFloorPoints(const AreaModel& am, const PlannerConfig& config, const V3& d_vis) {
+std::vector<V3> findFloorPoints(const AreaModel& am, const PlannerConfig& config, const V3& d_vis,
+                                const StopSignal* stop, std::vector<std::string>& warnings) {
   FloorPointParams fpp;
   fpp.d_vis = d_vis;
   fpp.spacing = config.floor_point_spacing;
   fpp.min_points = config.min_floor_points;
   fpp.lowest_n = config.lowest_n;
-  FloorPoints fp = floorPoints(am, fpp);
+  fpp.max_rays = config.max_floor_points;
+  FloorPoints fp = floorPoints(am, fpp, stop);
+  if (fp.coarsened) {
+    char msg[200];
+    std::snprintf(msg, sizeof msg, "floor_point_spacing %.3g m coarsened to %.3g m (max_floor_points = %d)",
+                  config.floor_point_spacing, fp.spacing, config.max_floor_points);
+    warnings.push_back(msg);
+  }
   std::vector<V3> kept;
   for (const V3& p : fp.points) {
     const Eigen::Vector3d pw = am.R_GW.transpose() * toEigen(p);
@@ -119,6 +131,76 @@ RobustnessParams robustnessParams(const PlannerConfig& config) {
   return rp;
 }
 
+// Between steps and while a setup step runs: false once the budget (`limit`, ms; 0 = none) is
+// spent or the caller cancels through the progress callback (called on the planner's thread).
+bool keepGoing(Clock::time_point t0, double limit, const ProgressCallback& progress, Progress p,
+               PlanResult& result) {
+  if (limit > 0 && msSince(t0) > limit) return !(result.timed_out = true);
+  if (!progress) return true;
+  p.elapsed_ms = msSince(t0);
+  if (!progress(p)) return !(result.cancelled = true);
+  return true;
+}
+
+// Runs a setup step on a worker while this thread watches the budget and the cancel every
+// 10 ms; when either says stop, the step is signalled and its end awaited (within ms: the
+// steps poll the signal). Empty when stopped.
+template <typename F>
+auto runStoppable(F&& step, StopSignal& stop, const std::function<bool()>& keep_going)
+    -> std::optional<decltype(step())> {
+  auto done = std::async(std::launch::async, std::forward<F>(step));
+  while (done.wait_for(std::chrono::milliseconds(10)) != std::future_status::ready)
+    if (!keep_going()) {
+      stop.request();
+      break;
+    }
+  try {
+    auto value = done.get();
+    if (stop.requested()) return std::nullopt;
+    return value;
+  } catch (const Stopped&) {
+    return std::nullopt;
+  }
+}
+
+// Bounded work (work_limits.h): sizes that say "millimetres", model memory; before any model.
+void checkLimits(const Mesh& object, const Mesh& area, const Radii& rad, bool area_cached,
+                 const PlannerConfig& config, PlanResult& result) {
+  for (std::string& w : checkMeshSizes(object, area, config)) result.warnings.push_back(std::move(w));
+  for (const Mesh* m : {&object, &area})
+    if (m->report.fanned_polygons > 0)
+      result.warnings.push_back(std::string(m == &object ? "object" : "placement area") + " mesh: " +
+                                std::to_string(m->report.fanned_polygons) +
+                                " self-intersecting polygons triangulated as fans (their shape is approximate)");
+  const size_t max_tri = static_cast<size_t>(config.max_triangles);
+  const double mb = (estimateModelBytes(object, rad.r, 0, 0, max_tri) +
+                     (area_cached ? 0.0 : estimateModelBytes(area, rad.r_area, rad.cd, rad.cell, max_tri))) /
+                    (1024.0 * 1024.0);
+  if (mb > config.max_model_mb) {
+    char msg[400];
+    std::snprintf(msg, sizeof msg,
+                  "the sphere models would take about %.0f MB, over max_model_mb = %.0f (object %.3g m, "
+                  "area %.3g m across, sphere radius %.2g m): raise the limit, a larger sphere_radius, "
+                  "or check the meshes' unit (metres)",
+                  mb, config.max_model_mb,
+                  (object.properties.bounds_max - object.properties.bounds_min).norm(),
+                  (area.properties.bounds_max - area.properties.bounds_min).norm(), rad.r);
+    throw LimitError(msg);
+  }
+}
+
+PlanResult& stopped(PlanResult& result, Clock::time_point t0) {  // by a cancel or the budget
+  result.stats.total_ms = msSince(t0);
+  return result;
+}
+
+std::string decimationWarning(const char* what, size_t from, size_t to, double cell) {
+  char msg[200];
+  std::snprintf(msg, sizeof msg, "%s decimated from %zu to %zu triangles (max_triangles; detail under %.2g m lost)",
+                what, from, to, cell);
+  return msg;
+}
+
 // The search's bookkeeping between batched steps: the penetration guard, the first robust
 // stable pose (each new stable leaf is checked at once until one holds), progress, budget.
 struct SearchMonitor {
@@ -135,6 +217,13 @@ struct SearchMonitor {
   size_t seen = 0;
   double best_q = 0;
   int stable_count = 0;
+
+  bool keepGoing(double limit) {
+    const PlanStats& st = result.stats;
+    return place_planner::keepGoing(t0, limit, progress,
+                                    Progress{st.floor_points_done, st.floor_points_total, best_q, stable_count, 0},
+                                    result);
+  }
 
   bool afterStep(std::vector<TreeLeaf>& all, int started, int open) {
     PlanStats& st = result.stats;
@@ -153,11 +242,13 @@ struct SearchMonitor {
       best_q = std::max(best_q, l.quality);
     }
     st.floor_points_done = (started - open) / std::max(1, orientations);
-    if (search_budget > 0 && msSince(t0) > search_budget) return !(result.timed_out = true);
-    if (!progress) return true;
-    const Progress p{st.floor_points_done, st.floor_points_total, best_q, stable_count, msSince(t0)};
-    if (!progress(p)) return !(result.cancelled = true);
-    return true;
+    if (st.tree_nodes >= config.max_tree_nodes) {
+      result.warnings.push_back("search stopped after max_tree_nodes = " + std::to_string(config.max_tree_nodes) +
+                                " poses; " + std::to_string(st.floor_points_done) + " of " +
+                                std::to_string(st.floor_points_total) + " floor points done");
+      return false;
+    }
+    return keepGoing(search_budget);
   }
 
   // Robustness for the ranking: what the search checked already, the rest now.
@@ -198,12 +289,40 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   const Eigen::Vector3d d_vis_W = config.approach.norm() > 1e-9 ? Eigen::Vector3d(config.approach.normalized()) : d_g_W;
   const Radii rad = sphereRadii(object, config);
   st.sphere_radius = rad.r;
+  const size_t max_tri = static_cast<size_t>(config.max_triangles);
+  checkLimits(object, area, rad, cache_->contains(area, d_g_W, rad.r_area, rad.cd, rad.cell, max_tri), config, result);
+  StopSignal stop;  // a cancel or the budget reaches the setup steps through it
+  const std::function<bool()> setup_going = [&] { return keepGoing(t0, budget, progress, Progress{}, result); };
   auto tp = Clock::now();
-  auto object_model = std::async(std::launch::async, [&] { return buildObjectModel(object, rad.r); });
-  const std::shared_ptr<const AreaModel> area_model = cache_->get(area, d_g_W, rad.r_area, rad.cd, rad.cell);
-  const ObjectModel om = object_model.get();
-  const AreaModel& am = *area_model;
+  struct Models {
+    std::optional<Mesh> object_small;  // the object decimated to max_triangles, if it had more
+    double object_cell = 0;             // ... with clusters of this size (m)
+    ObjectModel om;
+    std::shared_ptr<const AreaModel> am;
+  };
+  auto models = runStoppable(
+      [&] {
+        Models m;
+        auto area_model = std::async(std::launch::async, [&] {
+          return cache_->get(area, d_g_W, rad.r_area, rad.cd, rad.cell, max_tri, &stop);
+        });
+        if (object.triangles.size() > max_tri) m.object_small = decimated(object, max_tri, &m.object_cell, &stop);
+        m.om = buildObjectModel(m.object_small ? *m.object_small : object, rad.r, &stop);
+        m.am = area_model.get();
+        return m;
+      },
+      stop, setup_going);
   st.steps.setup = msSince(tp);
+  if (!models) return stopped(result, t0);
+  const Mesh& obj = models->object_small ? *models->object_small : object;
+  if (models->object_small)
+    result.warnings.push_back(
+        decimationWarning("object mesh", object.triangles.size(), obj.triangles.size(), models->object_cell));
+  const ObjectModel& om = models->om;
+  const AreaModel& am = *models->am;
+  if (am.triangles.size() < am.source_triangles)
+    result.warnings.push_back(
+        decimationWarning("placement area mesh", am.source_triangles, am.triangles.size(), am.decimation_cell));
   warnAboutGravity(area, am, d_g_W, result);
   const V3 d_vis = toV3(am.R_GW * d_vis_W);
   const std::unique_ptr<Backend> backend = chooseBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * rad.r}, config);
@@ -211,25 +330,35 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
 
   // ---- floor points (IV-B) and start orientations (IV-A): the roots
   tp = Clock::now();
-  const std::vector<V3> floor_G = findFloorPoints(am, config, d_vis);
-  for (const V3& p : floor_G) result.floor_points_W.push_back(am.R_GW.transpose() * toEigen(p));
-  st.steps.floor_points = msSince(tp);
   const Eigen::Matrix3d R_held_G = am.R_GW * config.start_orientation.normalized().toRotationMatrix();
-  const auto orientations = startOrientations(object, R_held_G, toEigen(d_vis), am, config);
-  const RootSearch roots(floor_G, orientations, object.properties, am, d_vis);
+  using Roots = std::pair<std::vector<V3>, std::vector<StartOrientation>>;
+  std::vector<std::string> floor_warnings;
+  const std::optional<Roots> root_parts = runStoppable(
+      [&] {
+        return Roots(findFloorPoints(am, config, d_vis, &stop, floor_warnings),
+                     startOrientations(obj, R_held_G, toEigen(d_vis), am, config, &stop));
+      },
+      stop, setup_going);
+  st.steps.floor_points = msSince(tp);
+  for (std::string& w : floor_warnings) result.warnings.push_back(std::move(w));
+  if (!root_parts) return stopped(result, t0);
+  const auto& [floor_G, orientations] = *root_parts;
+  for (const V3& p : floor_G) result.floor_points_W.push_back(am.R_GW.transpose() * toEigen(p));
+  const RootSearch roots(floor_G, orientations, obj.properties, am, d_vis);
   st.floor_points_total = static_cast<int>(floor_G.size());
   st.start_orientations = static_cast<int>(orientations.size());
   st.roots_total = roots.size();
 
   // ---- the trees of rotations (V, VI), every pending pose batched (VII-C)
-  const TreeContext ctx = treeContext(object, om, am, *backend, rad, config, st);
+  const TreeContext ctx = treeContext(obj, om, am, *backend, rad, config, st);
   const RobustnessParams rp = robustnessParams(config);
   std::vector<TreeLeaf> leaves;
+  std::function<bool()> robustness_going;  // the monitor's, once it exists
   auto robustness = [&](const std::vector<size_t>& idx) {  // robust stability, beyond the paper
     const auto tr = Clock::now();
     std::vector<Rigid> X;
     for (size_t i : idx) X.push_back(leaves[i].X_GO);
-    auto out = checkRobustness(X, ctx, rp, [&] { return budget <= 0 || msSince(t0) < budget; });
+    auto out = checkRobustness(X, ctx, rp, robustness_going);
     st.robustness_ms += msSince(tr);
     return out;
   };
@@ -237,6 +366,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   SearchMonitor monitor{om, am, config, progress, t0,
                         budget * (config.robust_check ? kSearchShareOfBudget : 1.0), rad.r,
                         static_cast<int>(orientations.size()), robustness, result, {}, 0, 0.0, 0};
+  robustness_going = [&] { return monitor.keepGoing(budget); };
   TreeStepper stepper(ctx);
   streamRoots(roots, stepper, om.com, std::max(16, 12 * resolveThreads(config.threads)), leaves,
               [&](int started, int open) { return monitor.afterStep(leaves, started, open); });
@@ -249,7 +379,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     kinds[k] = roots.kind(k);
     floor_W[k] = result.floor_points_W[roots.floorPoint(k)];
   }
-  const RankingInput in{leaves, kinds, floor_W, am.R_GW, R_held_G, object.properties.bounding_radius};
+  const RankingInput in{leaves, kinds, floor_W, am.R_GW, R_held_G, obj.properties.bounding_radius};
   result.candidates = rankCandidates(
       in, config, [&](const std::vector<size_t>& idx) { return monitor.robustnessOf(idx); }, &st);
   if (budget > 0 && msSince(t0) > budget) result.timed_out = true;

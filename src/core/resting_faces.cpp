@@ -80,7 +80,7 @@ struct HullBuilder {
 
 }  // namespace
 
-ConvexHull3 convexHull3d(const std::vector<Eigen::Vector3d>& points) {
+ConvexHull3 convexHull3d(const std::vector<Eigen::Vector3d>& points, const StopSignal* stop) {
   ConvexHull3 h;
   h.points = points;
   if (points.size() < 4) return h;
@@ -122,11 +122,15 @@ ConvexHull3 convexHull3d(const std::vector<Eigen::Vector3d>& points) {
   for (int e : ext) b.insert(e);
   std::vector<int> outside;
   for (size_t i = 0; i < points.size(); ++i) {
+    pollStop(stop, i, 1024);
     bool out = false;
     for (size_t fi = 0; fi < b.f.size() && !out; ++fi) out = b.alive[fi] && b.visible(static_cast<int>(fi), static_cast<int>(i));
     if (out) outside.push_back(static_cast<int>(i));
   }
-  for (int i : outside) b.insert(i);
+  for (size_t k = 0; k < outside.size(); ++k) {
+    pollStop(stop, k, 64);
+    b.insert(outside[k]);
+  }
   for (size_t fi = 0; fi < b.f.size(); ++fi)
     if (b.alive[fi] && b.n[fi].norm() > 0) {
       h.faces.push_back(b.f[fi]);
@@ -135,8 +139,9 @@ ConvexHull3 convexHull3d(const std::vector<Eigen::Vector3d>& points) {
   return h;
 }
 
-std::vector<RestingFace> restingFaces(const Mesh& object, double min_tipping_angle, double merge_deg) {
-  const ConvexHull3 hull = convexHull3d(object.vertices);
+std::vector<RestingFace> restingFaces(const Mesh& object, double min_tipping_angle, double merge_deg,
+                                      const StopSignal* stop) {
+  const ConvexHull3 hull = convexHull3d(object.vertices, stop);
   const Eigen::Vector3d com = object.properties.center_of_mass;
   const size_t nf = hull.faces.size();
   std::vector<double> area(nf);

@@ -10,7 +10,8 @@ namespace place_planner {
 
 SphereModel sampleSpheres(const std::vector<V3>& vertices,
                           const std::vector<std::array<int, 3>>& triangles,
-                          const std::vector<std::array<int, 2>>& edges, double radius) {
+                          const std::vector<std::array<int, 2>>& edges, double radius,
+                          const StopSignal* stop) {
   SphereModel m;
   m.radius = radius;
   const double step = 2.0 * radius;  // "the distance between two sphere centres is 2r"
@@ -22,7 +23,9 @@ SphereModel sampleSpheres(const std::vector<V3>& vertices,
   m.centres.reserve(static_cast<size_t>(1.1 * estimate));
   m.normals.reserve(static_cast<size_t>(1.1 * estimate));
   std::vector<V3> vnormal(vertices.size(), v3(0, 0, 0));
-  for (const auto& t : triangles) {
+  for (size_t ti = 0; ti < triangles.size(); ++ti) {
+    pollStop(stop, ti, 256);
+    const auto& t = triangles[ti];
     const V3 a = vertices[t[0]], b = vertices[t[1]], c = vertices[t[2]];
     const V3 n = cross(b - a, c - a);  // area-weighted
     for (int k = 0; k < 3; ++k) vnormal[t[k]] = vnormal[t[k]] + n;
@@ -56,7 +59,9 @@ SphereModel sampleSpheres(const std::vector<V3>& vertices,
     }
   }
   // Edges (sharp features are typical contacts) and vertices, once each.
-  for (const auto& e : edges) {
+  for (size_t ei = 0; ei < edges.size(); ++ei) {
+    pollStop(stop, ei, 1024);
+    const auto& e = edges[ei];
     const V3 a = vertices[e[0]], b = vertices[e[1]];
     const double len = norm(b - a);
     const int n = static_cast<int>(std::floor(len / step));
@@ -75,13 +80,16 @@ SphereModel sampleSpheres(const std::vector<V3>& vertices,
   return m;
 }
 
-HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, double cell) {
+HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, double cell,
+                           const StopSignal* stop) {
   HeightGrid g;
   g.collision_distance = cd;
   // Touching features meet to rounding after the exact translations and rotations; 0.25 mm
   // absorbs that and keeps curved surfaces from looking flat (a cylinder of 4 cm radius is
-  // within 0.25 mm of its tangent plane over a 9 mm wide band only: a line contact).
-  g.contact_gap = 2.5e-4 + 0.02 * cd;
+  // within 0.25 mm of its tangent plane over a 9 mm wide band only: a line contact). Small
+  // objects (cd under 2.5 mm) get a gap of their own scale, else a 3 degree tilt of a 5 mm cube
+  // would look flat.
+  g.contact_gap = std::min(2.5e-4, 0.1 * cd) + 0.02 * cd;
   g.cell = cell;
   g.x0 = bounds.lo.x - cd;
   g.y0 = bounds.lo.y - cd;
@@ -115,18 +123,23 @@ HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, 
     lower.get();
   };
   bands([&](int r0, int r1) {
-    for (const V3& c : s.centres) forCells(c, r0, r1, [&](size_t k) { ++count[k]; });
+    for (size_t i = 0; i < s.centres.size(); ++i) {
+      pollStop(stop, i, 4096);
+      forCells(s.centres[i], r0, r1, [&](size_t k) { ++count[k]; });
+    }
   });
   g.start.assign(ncell + 1, 0);
   for (size_t k = 0; k < ncell; ++k) g.start[k + 1] = g.start[k] + count[k];
   g.items.resize(g.start[ncell]);
   std::vector<int> fill(g.start.begin(), g.start.end() - 1);
   bands([&](int r0, int r1) {
-    for (size_t i = 0; i < s.centres.size(); ++i)
+    for (size_t i = 0; i < s.centres.size(); ++i) {
+      pollStop(stop, i, 4096);
       forCells(s.centres[i], r0, r1, [&](size_t k) {
         g.items[fill[k]++] = static_cast<int>(i);
         g.max_z[k] = std::max(g.max_z[k], s.centres[i].z + cd);  // "max z plus collision distance"
       });
+    }
   });
   return g;
 }

@@ -80,7 +80,8 @@ std::optional<double> areaWallDirection(const AreaModel& area) {
 
 std::vector<StartOrientation> startOrientations(const Mesh& object, const Eigen::Matrix3d& R_held_G,
                                                 const Eigen::Vector3d& d_vis_G,
-                                                const AreaModel& area, const PlannerConfig& config) {
+                                                const AreaModel& area, const PlannerConfig& config,
+                                                const StopSignal* stop) {
   std::vector<StartOrientation> out;
   auto add = [&](const Eigen::Matrix3d& R, StartKind kind) {
     for (const auto& s : out)
@@ -101,7 +102,7 @@ std::vector<StartOrientation> startOrientations(const Mesh& object, const Eigen:
   std::vector<Eigen::Matrix3d> resting;
   // Best margin first; faces as good as each other (within 0.1 degrees: a box's opposite
   // faces) in order of the turn they need from the held orientation.
-  std::vector<RestingFace> faces = restingFaces(object, min_tip);
+  std::vector<RestingFace> faces = restingFaces(object, min_tip, 4.0, stop);
   auto turn = [&](const RestingFace& f) { return std::acos(std::clamp((R_held_G * f.normal_O).dot(d_vis_G.normalized()), -1.0, 1.0)); };
   std::stable_sort(faces.begin(), faces.end(), [&](const RestingFace& a, const RestingFace& b) {
     const long ta = std::lround(a.tipping_angle / 1.7e-3), tb = std::lround(b.tipping_angle / 1.7e-3);

@@ -3,9 +3,12 @@
 #pragma once
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <memory>
 #include <string>
 
 namespace place_planner {
+
+struct GripperModel;  // gripper.h
 
 enum class OrientationMode {
   kAuto,           // default: resting faces of the hull, the held orientation, the principal
@@ -16,6 +19,13 @@ enum class OrientationMode {
 };
 
 enum class BackendKind { kAuto, kCpu, kCuda };
+
+// Ranking preference (ranking.h): the primary key among stable candidates.
+enum class RankOrder {
+  kQuality,  // default: Q with robustness and re-orientation
+  kLowest,   // lowest centre of mass along gravity first (bins, cups: the paper's 2nd observation)
+  kNearest,  // nearest to prefer_near first
+};
 
 struct PlannerConfig {
   Eigen::Vector3d gravity{0.0, 0.0, -1.0};   // d_g, normalised by the planner
@@ -55,6 +65,22 @@ struct PlannerConfig {
   double max_model_mb = 2000;                // estimated memory of both models; above: LimitError
   double max_object_size = 3.0;              // m across; above: LimitError naming the unit (mm?)
   double max_area_size = 100.0;              // m across; above: LimitError
+  // Manipulation (beyond the paper; placeability.h). With a grasp, the gripper rides with the
+  // object: its frame F is `grasp` (X_OF) in the object frame, F's z the approach axis.
+  bool has_grasp = false;
+  Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();
+  std::shared_ptr<const GripperModel> gripper;  // collision geometry in F; null: none
+  double max_gripper_tilt_deg = 60.0;        // F's z axis at most this far from straight down
+  double gripper_min_clearance = 0.001;      // m; the gripper nearer the area collides
+  bool keep_colliding = false;               // keep blocked candidates, marked with the reason
+  double approach_distance = 0.10;           // m, desired straight approach along d_vis
+  double approach_min_distance = 0.03;       // m, shortest acceptable
+  double retreat_distance = 0.10;            // m, the gripper backs off along -z of F
+  double retreat_min_distance = 0.03;        // m
+  // Preferences (ranking.h)
+  RankOrder rank_order = RankOrder::kQuality;
+  Eigen::Vector3d prefer_near{0.0, 0.0, 0.0};  // W, for kNearest
+  double min_edge_clearance = 0.0;           // m from a drop-off of the area (0 = off)
   // Optional region (planning frame) the floor points must lie in; inactive when min > max.
   Eigen::Vector3d region_min{1.0, 1.0, 1.0};
   Eigen::Vector3d region_max{-1.0, -1.0, -1.0};

@@ -42,6 +42,27 @@ struct PhysicsCheck {
 enum class StartKind { kRestingFace, kHeld, kPrincipalAxis, kAreaTurn, kAxis };
 const char* toString(StartKind k);
 
+// A straight motion (moveit_msgs/GripperTranslation): along `direction`, at least min_distance,
+// desired_distance if free. free_distance: how far it was checked free (up to desired).
+struct LinearMotion {
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // unit; frame below
+  double min_distance = 0.0, desired_distance = 0.0, free_distance = 0.0;
+};
+
+// The gripper and the motions around the goal (placeability.h); filled when the plan has a
+// grasp (retreat, gripper) or always (approach).
+struct Placement {
+  bool checked = false;
+  // Object pose before the approach: desired_distance back along the approach from its end
+  // (the goal when `straight`, else the first intermediate pose after the first contact).
+  Eigen::Isometry3d pre_place_W = Eigen::Isometry3d::Identity();
+  bool straight = true;         // the straight approach ends at the goal
+  LinearMotion approach;        // direction in W (d_vis)
+  LinearMotion retreat;         // the gripper's, direction in F (-z): free once released
+  double gripper_clearance = -1.0;  // m at the goal and on the way (-1: no gripper)
+  std::string blocked;          // empty, or why the gripper cannot place it ("goal", "approach", ...)
+};
+
 struct Candidate {
   Eigen::Isometry3d X_WO = Eigen::Isometry3d::Identity();  // goal pose of the object mesh frame
   double quality = 0.0;                                     // Q (Section VI), <= 1
@@ -55,6 +76,10 @@ struct Candidate {
   // Ordered: pre-placement pose above the floor point first, one per translation or rotation,
   // the goal pose last.
   std::vector<Eigen::Isometry3d> intermediate_poses;
+  Placement placement;
+  // With a grasp: the gripper frame F at the goal, X_WO * grasp.
+  bool has_gripper_pose = false;
+  Eigen::Isometry3d X_WF = Eigen::Isometry3d::Identity();
 };
 
 struct StepTimes {  // wall time per batched step, ms
@@ -69,6 +94,8 @@ struct PlanStats {
   int trees_without_rest = 0;      // trees cut by max_rotations before reaching a resting pose
   int robustness_checked = 0;      // stable leaves whose releases were perturbed
   int robustness_rejected = 0;     // ... found not robust (returned as not stable)
+  int gripper_rejected = 0;        // candidates the gripper blocks (dropped unless keep_colliding)
+  int gripper_tilt_rejected = 0;   // leaves whose gripper would point over max_gripper_tilt_deg
   int floor_points_total = 0;
   int floor_points_done = 0;
   long tree_nodes = 0;             // poses evaluated over all trees

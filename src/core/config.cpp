@@ -80,6 +80,23 @@ void validate(const PlannerConfig& c) {
           c.max_object_size, "> 0 m");
   require(std::isfinite(c.max_area_size) && c.max_area_size > 0, "max_area_size", c.max_area_size,
           "> 0 m");
+  require(std::isfinite(c.max_gripper_tilt_deg) && c.max_gripper_tilt_deg >= 0 && c.max_gripper_tilt_deg <= 180,
+          "max_gripper_tilt_deg", c.max_gripper_tilt_deg, "0 .. 180");
+  require(std::isfinite(c.gripper_min_clearance) && c.gripper_min_clearance >= 0, "gripper_min_clearance",
+          c.gripper_min_clearance, ">= 0 m");
+  for (auto [name, v] : {std::pair<const char*, double>{"approach_distance", c.approach_distance},
+                         {"approach_min_distance", c.approach_min_distance},
+                         {"retreat_distance", c.retreat_distance},
+                         {"retreat_min_distance", c.retreat_min_distance},
+                         {"min_edge_clearance", c.min_edge_clearance}})
+    require(std::isfinite(v) && v >= 0 && v <= 2, name, v, "0 .. 2 m");
+  require(c.approach_min_distance <= c.approach_distance, "approach_min_distance", c.approach_min_distance,
+          "<= approach_distance");
+  require(c.retreat_min_distance <= c.retreat_distance, "retreat_min_distance", c.retreat_min_distance,
+          "<= retreat_distance");
+  requireVector(c.prefer_near, "prefer_near", true);
+  require(c.grasp.matrix().allFinite() && std::abs(c.grasp.linear().determinant() - 1.0) < 1e-3, "grasp",
+          c.grasp.linear().determinant(), "a rigid transform (rotation determinant 1)");
   require(std::isfinite(c.merge_angle_deg) && c.merge_angle_deg >= 0, "merge_angle_deg",
           c.merge_angle_deg, ">= 0");
 }

@@ -20,6 +20,7 @@
 #include "place_planner/floor_points.h"
 #include "place_planner/parallel_for.h"
 #include "place_planner/penetration.h"
+#include "place_planner/placeability.h"
 #include "place_planner/ranking.h"
 #include "place_planner/robustness.h"
 #include "place_planner/root_search.h"
@@ -342,7 +343,13 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   st.steps.floor_points = msSince(tp);
   for (std::string& w : floor_warnings) result.warnings.push_back(std::move(w));
   if (!root_parts) return stopped(result, t0);
-  const auto& [floor_G, orientations] = *root_parts;
+  const std::vector<V3>& floor_G = root_parts->first;
+  // With a grasp, orientations pointing the gripper over max_gripper_tilt_deg are not searched.
+  std::vector<StartOrientation> orientations;
+  for (const StartOrientation& o : root_parts->second)
+    if (gripperTiltOk(o.R_GO, config)) orientations.push_back(o);
+  if (orientations.empty())
+    result.warnings.push_back("no start orientation points the gripper within max_gripper_tilt_deg of straight down");
   for (const V3& p : floor_G) result.floor_points_W.push_back(am.R_GW.transpose() * toEigen(p));
   const RootSearch roots(floor_G, orientations, obj.properties, am, d_vis);
   st.floor_points_total = static_cast<int>(floor_G.size());
@@ -379,9 +386,15 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     kinds[k] = roots.kind(k);
     floor_W[k] = result.floor_points_W[roots.floorPoint(k)];
   }
-  const RankingInput in{leaves, kinds, floor_W, am.R_GW, R_held_G, obj.properties.bounding_radius};
+  const RankingInput in{leaves, kinds, floor_W, am.R_GW, R_held_G, obj.properties.bounding_radius,
+                        obj.properties.center_of_mass};
+  const PlaceabilityContext pc{om, am, *backend, d_vis, config};
   result.candidates = rankCandidates(
-      in, config, [&](const std::vector<size_t>& idx) { return monitor.robustnessOf(idx); }, &st);
+      in, config, [&](const std::vector<size_t>& idx) { return monitor.robustnessOf(idx); }, &st,
+      [&](size_t i) { return checkPlacement(leaves[i], pc); });
+  if (config.has_grasp && config.gripper && result.stableCount() == 0 && st.gripper_rejected > 0)
+    result.warnings.push_back("the gripper blocks every stable pose checked (" + std::to_string(st.gripper_rejected) +
+                              " candidates): at the goal, on the approach or the retreat");
   if (budget > 0 && msSince(t0) > budget) result.timed_out = true;
   st.total_ms = msSince(t0);
   return result;

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "place_planner/contact_points.h"
+#include "place_planner/placeability.h"
 
 namespace place_planner {
 namespace {
@@ -15,6 +16,8 @@ struct Item {
   double quality, reorientation;
   Robustness robustness;
   bool checked = false;
+  long preference = 0;  // config.rank_order's key, lower first
+  Placement placement;
   double score() const {
     const double share = checked ? robustness.share() : 1.0;
     return quality - 0.05 * reorientation / M_PI - 0.05 * (1.0 - share);
@@ -29,6 +32,7 @@ long quantised(double v, double step) { return std::lround(v / step); }
 void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
   std::stable_sort(items.begin(), items.end(), [&](const Item& a, const Item& b) {
     if (a.stable != b.stable) return a.stable;
+    if (a.preference != b.preference) return a.preference < b.preference;
     const long sa = quantised(a.score(), 1e-3), sb = quantised(b.score(), 1e-3);
     if (sa != sb) return sa > sb;
     const V3 pa = leaves[a.leaf].X_GO.t, pb = leaves[b.leaf].X_GO.t;
@@ -45,14 +49,23 @@ void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
 }  // namespace
 
 std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfig& config,
-                                      const RobustnessCheck& check, PlanStats* stats) {
+                                      const RobustnessCheck& check, PlanStats* stats,
+                                      const PlacementCheck& place) {
   const auto& leaves = in.leaves;
   std::vector<Item> items;
+  const Eigen::Vector3d near_G = in.R_GW * config.prefer_near;
   for (size_t i = 0; i < leaves.size(); ++i) {
     const TreeLeaf& l = leaves[i];
     if (l.quality < config.min_quality) continue;
-    items.push_back({i, l.stable, l.quality,
-                     rotationAngle(in.R_held_G, toIsometry(l.X_GO).linear()), {}, false});
+    const Eigen::Isometry3d X = toIsometry(l.X_GO);
+    if (!gripperTiltOk(X.linear(), config)) {
+      if (stats) ++stats->gripper_tilt_rejected;
+      continue;
+    }
+    Item it{i, l.stable, l.quality, rotationAngle(in.R_held_G, X.linear()), {}, false, 0, {}};
+    if (config.rank_order == RankOrder::kLowest) it.preference = quantised((X * in.com_O).z(), 0.005);
+    if (config.rank_order == RankOrder::kNearest) it.preference = quantised((X * in.com_O - near_G).norm(), 0.005);
+    items.push_back(it);
   }
   sortItems(items, leaves);
   // Merge: a pose near a better one is the same candidate (G and W differ by a rotation only).
@@ -72,6 +85,18 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     distinct.push_back(it);
     kept.push_back(X);
   }
+  // Placeability first (cheap next to robustness): a blocked candidate is not stable.
+  int place_checks = 0;
+  auto placeable = [&](Item& it) {
+    if (!place || it.placement.checked) return it.placement.blocked.empty();
+    // Bounded work: when the gripper blocks pose after pose, the search for more stops.
+    if (++place_checks > 10 * config.max_candidates) return false;
+    it.placement = place(it.leaf);
+    if (it.placement.blocked.empty()) return true;
+    if (stats) ++stats->gripper_rejected;
+    it.stable = false;
+    return false;
+  };
   // Robustness, best stable first, until max_candidates robust ones are found.
   if (config.robust_check && check) {
     int robust = 0, checked = 0;
@@ -80,7 +105,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     while (robust < config.max_candidates && checked < 4 * config.max_candidates) {
       std::vector<size_t> batch, where;
       for (; next < distinct.size() && batch.size() < static_cast<size_t>(config.max_candidates - robust); ++next)
-        if (distinct[next].stable) {
+        if (distinct[next].stable && placeable(distinct[next])) {
           batch.push_back(distinct[next].leaf);
           where.push_back(next);
         }
@@ -108,8 +133,19 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
   }
   const Eigen::Matrix3d R_WG = in.R_GW.transpose();
   std::vector<Candidate> out;
+  if (place) {
+    // Without the robustness loop, or past it: the rest are checked in rank order.
+    int kept = 0;
+    for (Item& it : distinct) {
+      if (kept >= config.max_candidates) break;
+      kept += placeable(it) || config.keep_colliding;
+    }
+    sortItems(distinct, leaves);
+  }
   for (const Item& it : distinct) {
     if (static_cast<int>(out.size()) >= config.max_candidates) break;
+    if (place && !it.placement.checked) continue;
+    if (!it.placement.blocked.empty() && !config.keep_colliding) continue;
     const TreeLeaf& l = leaves[it.leaf];
     Candidate c;
     const Eigen::Isometry3d X_GO = toIsometry(l.X_GO);
@@ -124,6 +160,11 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     for (const auto& p : reduceContacts(l.contacts, in.object_radius / 3.0))
       c.contacts.push_back({R_WG * p.p_W, R_WG * p.n_W});
     c.floor_point_W = in.root_floor_point_W[l.root];
+    c.placement = it.placement;
+    if (config.has_grasp) {
+      c.has_gripper_pose = true;
+      c.X_WF = c.X_WO * config.grasp;
+    }
     for (const Rigid& X : l.path) {
       const Eigen::Isometry3d T = toIsometry(X);
       Eigen::Isometry3d W = Eigen::Isometry3d::Identity();

@@ -6,3 +6,13 @@ set_target_properties(place_planner_gripper PROPERTIES POSITION_INDEPENDENT_CODE
 target_include_directories(place_planner_gripper PUBLIC ${urdfdom_INCLUDE_DIRS})
 target_link_libraries(place_planner_gripper PUBLIC place_planner_core ${urdfdom_LIBRARIES})
 target_compile_options(place_planner_gripper PRIVATE ${PP_WARN})
+
+if(CATKIN_ENABLE_TESTING)
+  catkin_add_gtest(gripper_tests ${PROJECT_SOURCE_DIR}/test/gripper/test_gripper.cpp
+                   ${PROJECT_SOURCE_DIR}/test/core/main.cpp)
+  target_link_libraries(gripper_tests place_planner_gripper)
+  get_filename_component(PP_REAL_SOURCE_DIR ${PROJECT_SOURCE_DIR} REALPATH)
+  target_compile_definitions(gripper_tests PRIVATE
+    PP_SOURCE_DIR="${PP_REAL_SOURCE_DIR}"
+    PP_SHARED_DATA_DIR="${PP_REAL_SOURCE_DIR}/../shared/data")
+endif()

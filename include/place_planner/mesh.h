@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "place_planner/stop_signal.h"
+
 namespace place_planner {
 
 // Misuse of the mesh API or a broken input: the message names the element and index.
@@ -58,8 +60,10 @@ struct Mesh {
 // 3 vertices. Zero-area polygons are dropped and counted; non-planar or non-convex polygons are
 // split into triangles (ear clipping in their best-fit plane). Throws when nothing is left.
 // `name` prefixes the messages (e.g. "object mesh").
+// `stop` (may be null; stop_signal.h) interrupts a long build with Stopped.
 Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
-               const std::vector<std::vector<int>>& polygons, const std::string& name = "mesh");
+               const std::vector<std::vector<int>>& polygons, const std::string& name = "mesh",
+               const StopSignal* stop = nullptr);
 
 // Recomputes centre of mass (area-weighted over the surface, since sensor meshes are not
 // watertight), principal axes of the surface's second moment, bounds and bounding radius.

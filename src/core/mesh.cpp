@@ -87,7 +87,8 @@ std::vector<std::array<int, 3>> earClip(const std::vector<Eigen::Vector3d>& v,
 }  // namespace
 
 Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
-               const std::vector<std::vector<int>>& polygons, const std::string& name) {
+               const std::vector<std::vector<int>>& polygons, const std::string& name,
+               const StopSignal* stop) {
   if (vertices.empty()) throw MeshError(name + ": empty mesh (no vertices)");
   if (polygons.empty()) throw MeshError(name + ": empty mesh (no polygons)");
   const int nv = static_cast<int>(vertices.size());
@@ -135,7 +136,11 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
     m.patches.push_back(std::move(poly));
     m.patch_normals.push_back(n);
   };
-  for (const auto& poly_in : polygons) {
+  m.patches.reserve(polygons.size());
+  m.patch_normals.reserve(polygons.size());
+  for (size_t f = 0; f < polygons.size(); ++f) {
+    pollStop(stop, f, 1u << 14);
+    const auto& poly_in = polygons[f];
     // Drop consecutive repeated indices (common in decimated scans).
     std::vector<int> poly;
     for (int idx : poly_in)
@@ -175,7 +180,9 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
 
   // Unique edges in the order of their first use: (key, first use) pairs sorted, one per key.
   std::vector<std::pair<uint64_t, size_t>> uses;
+  uses.reserve(3 * m.patches.size());
   for (size_t f = 0; f < m.patches.size(); ++f) {
+    pollStop(stop, f, 1u << 14);
     const auto& poly = m.patches[f];
     for (size_t i = 1; i + 1 < poly.size(); ++i) {
       m.triangles.push_back({poly[0], poly[i], poly[i + 1]});
@@ -187,7 +194,9 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
       uses.emplace_back((static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b), uses.size());
     }
   }
+  if (stop) stop->throwIfRequested();
   std::sort(uses.begin(), uses.end());
+  if (stop) stop->throwIfRequested();
   std::vector<size_t> first;
   for (size_t i = 0; i < uses.size(); ++i)
     if (i == 0 || uses[i].first != uses[i - 1].first) first.push_back(i);

@@ -102,7 +102,7 @@ Mesh decimated(const Mesh& mesh, size_t max_triangles, double* cell_out, const S
     if (polys.size() > max_triangles || polys.empty() || sum.size() >= (1u << 21)) continue;
     std::vector<Eigen::Vector3d> verts(sum.size());
     for (size_t k = 0; k < sum.size(); ++k) verts[k] = sum[k] / count[k];
-    Mesh out = buildMesh(verts, polys, "decimated mesh");
+    Mesh out = buildMesh(verts, polys, "decimated mesh", stop);
     if (out.triangles.size() > max_triangles) continue;
     // The object's mass properties stay the input's: the answer is for the real object.
     const MeshProperties p = out.properties;

@@ -1,175 +1,146 @@
-// CUDA launcher of the four batched kernels (Section VII-C). The per-pose bodies are the
-// __host__ __device__ functions of kernels/placement_kernels.h that the CPU backend runs;
-// here the scene is uploaded once and each GPU thread takes one (pose, direction) pair for the
-// rotation and distance kernels and one (pose, sphere) pair for the contact kernel.
+// The CUDA device of the one launcher (kernels/batched_steps.h): a grid-stride kernel over the
+// same work items the CPU pool runs, device memory from a pool that grows and is reused, one
+// stream per backend (per plan). The area's model is uploaded once per build and kept on the
+// device beside the host cache (keyed by AreaModel::id); the object's per plan.
+#include <algorithm>
+#include <list>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "cuda_common.cuh"
 #include "place_planner/backend.h"
 #include "place_planner/cuda_backend.h"
+#include "place_planner/kernels/batched_steps.h"
 
 namespace place_planner {
 namespace {
 
-template <typename T>
-struct Dev {
-  std::unique_ptr<cuda::DeviceBuffer<T>> buf;
-  const T* upload(const std::vector<T>& h) {
-    buf = std::make_unique<cuda::DeviceBuffer<T>>(h.size());
-    buf->upload(h.data());
-    return h.empty() ? nullptr : buf->get();
+template <typename F>
+__global__ void gridStride(F f, size_t n) {
+  for (size_t i = blockIdx.x * static_cast<size_t>(blockDim.x) + threadIdx.x; i < n;
+       i += static_cast<size_t>(blockDim.x) * gridDim.x)
+    f(i);
+}
+
+// Device copies of a model's arrays, freed with it.
+struct DeviceArrays {
+  std::vector<std::shared_ptr<void>> blocks;
+  template <typename T>
+  const T* operator()(const std::vector<T>& h) {
+    if (h.empty()) return nullptr;
+    void* p = nullptr;
+    PP_CUDA_CHECK(cudaMalloc(&p, h.size() * sizeof(T)));
+    blocks.emplace_back(p, [](void* q) { cudaFree(q); });
+    PP_CUDA_CHECK(cudaMemcpy(p, h.data(), h.size() * sizeof(T), cudaMemcpyHostToDevice));
+    return static_cast<const T*>(p);
   }
 };
 
-struct DevBvh {
-  Dev<BvhNode> nodes;
-  Dev<int> order;
-  BvhView upload(const Bvh& b) {
-    return BvhView{nodes.upload(b.nodes), order.upload(b.order), static_cast<int>(b.nodes.size())};
-  }
+struct DeviceArea {
+  uint64_t id;
+  DeviceArrays arrays;
+  AreaView view;
 };
 
-struct DevMesh {
-  Dev<V3> vertices, normals, centres, snormals;
-  Dev<int> tris, edges;
-  DevBvh tb, eb, vb, sb;
-  MeshView upload(const MeshModel& m) {
-    MeshView v;
-    v.vertices = vertices.upload(m.vertices);
-    std::vector<int> t(m.triangles.size() * 3), e(m.edges.size() * 2);
-    for (size_t i = 0; i < m.triangles.size(); ++i)
-      for (int k = 0; k < 3; ++k) t[3 * i + k] = m.triangles[i][k];
-    for (size_t i = 0; i < m.edges.size(); ++i)
-      for (int k = 0; k < 2; ++k) e[2 * i + k] = m.edges[i][k];
-    v.triangles = tris.upload(t);
-    v.edges = edges.upload(e);
-    v.triangle_normals = normals.upload(m.triangle_normals);
-    v.num_vertices = static_cast<int>(m.vertices.size());
-    v.num_triangles = static_cast<int>(m.triangles.size());
-    v.num_edges = static_cast<int>(m.edges.size());
-    v.triangle_bvh = tb.upload(m.triangle_bvh);
-    v.edge_bvh = eb.upload(m.edge_bvh);
-    v.vertex_bvh = vb.upload(m.vertex_bvh);
-    v.sphere_centres = centres.upload(m.spheres.centres);
-    v.sphere_normals = snormals.upload(m.spheres.normals);
-    v.num_spheres = static_cast<int>(m.spheres.centres.size());
-    v.sphere_radius = m.spheres.radius;
-    v.sphere_bvh = sb.upload(m.spheres.bvh);
-    v.bounds = m.bounds;
-    return v;
-  }
-};
-
-__global__ void distanceKernel(ObjectView o, AreaView a, const TranslationQuery* q, double* t, int n) {
-  const int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) t[i] = firstContactDistance(o, a, q[i].X_GO, q[i].d, q[i].tmax);
+// The last few areas' device copies (the host cache holds four models too).
+std::shared_ptr<DeviceArea> deviceArea(const AreaModel& a) {
+  static std::mutex mutex;
+  static std::list<std::shared_ptr<DeviceArea>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  for (const auto& d : cache)
+    if (d->id == a.id) return d;
+  auto d = std::make_shared<DeviceArea>();
+  d->id = a.id;
+  d->view = makeAreaView(a, d->arrays);
+  cache.push_front(d);
+  if (cache.size() > 4) cache.pop_back();
+  return d;
 }
 
-__global__ void vertexSurfaceKernel(ObjectView o, AreaView a, const RotationQuery* q, double* out,
-                                    int n, TiltParams tp) {
-  const int k = blockIdx.x * blockDim.x + threadIdx.x;
-  if (k >= 2 * n) return;
-  const int i = k / 2, sigma = k % 2 ? -1 : 1;
-  out[k] = vertexSurfaceAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp,
-                              sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
-}
-
-__global__ void edgeEdgeKernel(ObjectView o, AreaView a, const RotationQuery* q, double* out, int n,
-                               TiltParams tp) {
-  const int k = blockIdx.x * blockDim.x + threadIdx.x;
-  if (k >= 2 * n) return;
-  const int i = k / 2, sigma = k % 2 ? -1 : 1;
-  out[k] = edgeEdgeAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp,
-                         sigma > 0 ? q[i].limit_ccw : q[i].limit_cw);
-}
-
-__global__ void contactKernel(ObjectView o, AreaView a, const Rigid* X, SphereContact* c, int poses) {
-  const long k = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x;
-  const int ns = o.mesh.num_spheres;
-  if (k >= static_cast<long>(poses) * ns) return;
-  const int i = static_cast<int>(k / ns), s = static_cast<int>(k % ns);
-  c[k] = sphereContact(a, apply(X[i], o.mesh.sphere_centres[s]),
-                       rotate(X[i], o.mesh.sphere_normals[s]), apply(X[i], o.com));
-}
-
-class CudaBackend : public Backend {
+class CudaDevice {
  public:
-  CudaBackend(const ObjectModel& o, const AreaModel& a, const TiltParams& tp) : tp_(tp) {
-    obj_ = ObjectView{om_.upload(o), o.com, o.bounding_radius};
-    const HeightGrid& g = a.grid;
-    area_ = AreaView{am_.upload(a), GridView{g.x0, g.y0, g.cell, g.nx, g.ny, g.collision_distance, g.contact_gap,
-                                             start_.upload(g.start), items_.upload(g.items),
-                                             maxz_.upload(g.max_z)}};
-    // Deep per-thread traversal stacks: raise the stack size for the rotation kernels.
-    PP_CUDA_CHECK(cudaDeviceSetLimit(cudaLimitStackSize, 16384));
+  CudaDevice(const ObjectModel& o, const AreaModel& a) {
+    // Deep per-thread traversal stacks for the rotation kernels: set once per process.
+    static std::once_flag limit;
+    std::call_once(limit, [] { PP_CUDA_CHECK(cudaDeviceSetLimit(cudaLimitStackSize, 16384)); });
+    PP_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
+    obj_ = makeObjectView(o, obj_arrays_);
+    area_ = deviceArea(a);
   }
-  std::string name() const override { return "cuda"; }
+  ~CudaDevice() {
+    cudaStreamSynchronize(stream_);
+    for (auto& b : pool_)
+      if (b.ptr) cudaFree(b.ptr);
+    cudaStreamDestroy(stream_);
+  }
+  CudaDevice(const CudaDevice&) = delete;
+  CudaDevice& operator=(const CudaDevice&) = delete;
 
-  void distance(const std::vector<TranslationQuery>& q, std::vector<double>& t) override {
-    t.assign(q.size(), kInf);
-    if (q.empty()) return;
-    cuda::DeviceBuffer<TranslationQuery> dq(q.size());
-    cuda::DeviceBuffer<double> dt(q.size());
-    dq.upload(q.data());
-    distanceKernel<<<cuda::blocksFor(q.size(), 64), 64>>>(obj_, area_, dq.get(), dt.get(),
-                                                          static_cast<int>(q.size()));
-    finish();
-    dt.download(t.data());
+  std::string name() const { return "cuda"; }
+  // Every pending pose in one launch, as far as 1 GiB of contact slots allows.
+  size_t preferredBatch(size_t spheres) const {
+    const size_t by_memory = (size_t(1) << 30) / (std::max<size_t>(spheres, 1) * sizeof(SphereContact));
+    return std::clamp<size_t>(by_memory, 64, 8192);
   }
-  void vertexSurfaceRotation(const std::vector<RotationQuery>& q, std::vector<AnglePair>& a) override {
-    rotation(q, a, true);
-  }
-  void edgeEdgeRotation(const std::vector<RotationQuery>& q, std::vector<AnglePair>& a) override {
-    rotation(q, a, false);
-  }
-  void contactPoints(const std::vector<Rigid>& X,
-                     std::vector<std::vector<SphereContact>>& out) override {
-    const size_t ns = static_cast<size_t>(obj_.mesh.num_spheres);
-    const size_t n = X.size() * ns;
-    out.assign(X.size(), {});
+  const ObjectView& object() const { return obj_; }
+  const AreaView& area() const { return area_->view; }
+
+  template <typename F>
+  void parallelFor(size_t n, const F& f) {
     if (n == 0) return;
-    std::vector<SphereContact> c(n);
-    cuda::DeviceBuffer<Rigid> dx(X.size());
-    cuda::DeviceBuffer<SphereContact> dc(n);
-    dx.upload(X.data());
-    contactKernel<<<cuda::blocksFor(n), 256>>>(obj_, area_, dx.get(), dc.get(), static_cast<int>(X.size()));
-    finish();
-    dc.download(c.data());
-    // Compact per pose; reduceContacts() does not depend on the order.
-    for (size_t i = 0; i < X.size(); ++i)
-      for (size_t s = 0; s < ns; ++s)
-        if (c[i * ns + s].valid) out[i].push_back(c[i * ns + s]);
+    const unsigned blocks = static_cast<unsigned>(std::min<size_t>((n + 127) / 128, 65535));
+    gridStride<<<blocks, 128, 0, stream_>>>(f, n);
+    PP_CUDA_CHECK(cudaGetLastError());
+  }
+  template <typename T>
+  T* scratch(int slot, size_t n) {
+    return static_cast<T*>(grow(slot, n * sizeof(T)));
+  }
+  template <typename T>
+  const T* upload(int slot, const std::vector<T>& host) {
+    T* d = static_cast<T*>(grow(kUploadSlots + slot, host.size() * sizeof(T)));
+    if (!host.empty())
+      PP_CUDA_CHECK(cudaMemcpyAsync(d, host.data(), host.size() * sizeof(T), cudaMemcpyHostToDevice, stream_));
+    return d;
+  }
+  template <typename T>
+  void download(const T* dev, size_t n, T* host) {
+    if (n == 0) return;
+    PP_CUDA_CHECK(cudaMemcpyAsync(host, dev, n * sizeof(T), cudaMemcpyDeviceToHost, stream_));
+    PP_CUDA_CHECK(cudaStreamSynchronize(stream_));
+  }
+  void finish() {
+    PP_CUDA_CHECK(cudaGetLastError());
+    PP_CUDA_CHECK(cudaStreamSynchronize(stream_));
   }
 
  private:
-  void rotation(const std::vector<RotationQuery>& q, std::vector<AnglePair>& a, bool vertex) {
-    a.assign(q.size(), AnglePair{});
-    if (q.empty()) return;
-    cuda::DeviceBuffer<RotationQuery> dq(q.size());
-    cuda::DeviceBuffer<double> out(2 * q.size());
-    dq.upload(q.data());
-    const int n = static_cast<int>(q.size());
-    if (vertex)
-      vertexSurfaceKernel<<<cuda::blocksFor(2 * q.size(), 64), 64>>>(obj_, area_, dq.get(), out.get(), n, tp_);
-    else
-      edgeEdgeKernel<<<cuda::blocksFor(2 * q.size(), 64), 64>>>(obj_, area_, dq.get(), out.get(), n, tp_);
-    finish();
-    std::vector<double> h(2 * q.size());
-    out.download(h.data());
-    for (size_t i = 0; i < q.size(); ++i) a[i] = AnglePair{h[2 * i], h[2 * i + 1]};
-  }
-  static void finish() {
-    PP_CUDA_CHECK(cudaGetLastError());
-    PP_CUDA_CHECK(cudaDeviceSynchronize());
+  static constexpr int kUploadSlots = 8;
+  struct Block {
+    void* ptr = nullptr;
+    size_t bytes = 0;
+  };
+  // Grow-only per slot: a plan allocates a few times, not once per step.
+  void* grow(int slot, size_t bytes) {
+    Block& b = pool_[slot];
+    if (b.bytes < bytes) {
+      PP_CUDA_CHECK(cudaStreamSynchronize(stream_));
+      if (b.ptr) PP_CUDA_CHECK(cudaFree(b.ptr));
+      b.ptr = nullptr;
+      b.bytes = 0;
+      const size_t want = std::max<size_t>(bytes + bytes / 2, 4096);
+      PP_CUDA_CHECK(cudaMalloc(&b.ptr, want));
+      b.bytes = want;
+    }
+    return b.ptr;
   }
 
-  TiltParams tp_;
-  DevMesh om_, am_;
-  Dev<int> start_, items_;
-  Dev<double> maxz_;
+  cudaStream_t stream_ = nullptr;
+  DeviceArrays obj_arrays_;
   ObjectView obj_;
-  AreaView area_;
+  std::shared_ptr<DeviceArea> area_;
+  Block pool_[2 * kUploadSlots];
 };
 
 }  // namespace
@@ -178,7 +149,7 @@ std::unique_ptr<Backend> makeCudaBackend(const ObjectModel& object, const AreaMo
                                          const TiltParams& tilt) {
   std::string why;
   if (!cuda::available(&why)) throw std::runtime_error("CUDA backend unavailable: " + why);
-  return std::make_unique<CudaBackend>(object, area, tilt);
+  return std::make_unique<BatchedBackend<CudaDevice>>(tilt, object, area);
 }
 
 }  // namespace place_planner

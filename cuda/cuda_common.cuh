@@ -4,12 +4,19 @@
 #include <stdexcept>
 #include <string>
 
+#include "place_planner/cuda_backend.h"
+
+// A failed CUDA call throws (the goal fails with INTERNAL_ERROR) and marks the device
+// unusable for backend auto until cuda::resetDevice() (cuda_backend.h).
 #define PP_CUDA_CHECK(call)                                                                   \
   do {                                                                                        \
     const cudaError_t pp_err = (call);                                                        \
-    if (pp_err != cudaSuccess)                                                                \
-      throw std::runtime_error(std::string("CUDA error in ") + #call + ": " +                 \
-                               cudaGetErrorString(pp_err));                                   \
+    if (pp_err != cudaSuccess) {                                                              \
+      const std::string pp_msg = std::string("CUDA error in ") + #call + ": " +              \
+                                 cudaGetErrorString(pp_err);                                  \
+      ::place_planner::cuda::markUnusable(pp_msg);                                            \
+      throw std::runtime_error(pp_msg);                                                       \
+    }                                                                                         \
   } while (0)
 
 namespace place_planner {

@@ -12,6 +12,9 @@ bool available(std::string* why) {
   return false;
 }
 
+void markUnusable(const std::string&) {}
+void resetDevice() {}
+
 void transformVertices(const Rigid&, const V3*, V3*, size_t) {
   throw std::runtime_error("place_planner was built without CUDA");
 }

@@ -1,10 +1,34 @@
+#include <mutex>
+
 #include "cuda_common.cuh"
 #include "place_planner/cuda_backend.h"
 
 namespace place_planner {
 namespace cuda {
+namespace {
+std::mutex g_fault_mutex;
+std::string g_fault;  // empty: usable
+}  // namespace
+
+void markUnusable(const std::string& why) {
+  std::lock_guard<std::mutex> lock(g_fault_mutex);
+  if (g_fault.empty()) g_fault = why;
+}
+
+void resetDevice() {
+  std::lock_guard<std::mutex> lock(g_fault_mutex);
+  g_fault.clear();
+  cudaDeviceReset();
+}
 
 bool available(std::string* why) {
+  {
+    std::lock_guard<std::mutex> lock(g_fault_mutex);
+    if (!g_fault.empty()) {
+      if (why) *why = "device marked unusable after a fault (" + g_fault + "); cuda::resetDevice() clears it";
+      return false;
+    }
+  }
   int n = 0;
   const cudaError_t err = cudaGetDeviceCount(&n);
   if (err != cudaSuccess) {

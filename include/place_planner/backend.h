@@ -35,6 +35,9 @@ class Backend {
  public:
   virtual ~Backend() = default;
   virtual std::string name() const = 0;
+  // Poses the planner should batch per step: the CPU a few per thread, a GPU every pending
+  // pose of every root (as many as its memory for the contact kernel allows).
+  virtual size_t preferredBatch() const = 0;
   // Distance kernel: t per query (kInf: no contact within tmax).
   virtual void distance(const std::vector<TranslationQuery>& q, std::vector<double>& t) = 0;
   // Vertex/surface and edge/edge rotation kernels.
@@ -52,7 +55,8 @@ AreaView view(const AreaModel& a);
 
 std::unique_ptr<Backend> makeCpuBackend(const ObjectModel& object, const AreaModel& area,
                                         const TiltParams& tilt, int threads);
-// Throws std::runtime_error when CUDA is not built in or no GPU answers.
+// Throws std::runtime_error when CUDA is not built in, no GPU answers or the device was
+// marked unusable by an earlier fault (cuda_backend.h).
 std::unique_ptr<Backend> makeCudaBackend(const ObjectModel& object, const AreaModel& area,
                                          const TiltParams& tilt);
 

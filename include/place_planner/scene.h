@@ -5,6 +5,7 @@
 #pragma once
 #include <Eigen/Geometry>
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -54,6 +55,7 @@ struct AreaModel : MeshModel {  // frame G
   Eigen::Matrix3d R_GW;  // rotation from the planning frame W into G
   double up_facing_share = 1.0;  // of the surface, facing against gravity (area_up.h)
   size_t source_triangles = 0;   // of the mesh given; more than triangles.size() when decimated
+  uint64_t id = 0;               // unique per build: the key of the CUDA backend's device copy
   double decimation_cell = 0.0;  // m, cluster size of the decimation (0: none)
 };
 

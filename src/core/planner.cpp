@@ -375,7 +375,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
                         static_cast<int>(orientations.size()), robustness, result, {}, 0, 0.0, 0};
   robustness_going = [&] { return monitor.keepGoing(budget); };
   TreeStepper stepper(ctx);
-  streamRoots(roots, stepper, om.com, std::max(16, 12 * resolveThreads(config.threads)), leaves,
+  streamRoots(roots, stepper, om.com, static_cast<int>(backend->preferredBatch()), leaves,
               [&](int started, int open) { return monitor.afterStep(leaves, started, open); });
   for (const TreeLeaf& l : leaves) st.trees_without_rest += !l.at_rest;
 

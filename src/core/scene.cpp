@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <future>
+#include <atomic>
 #include <cstdint>
 
 #include "place_planner/area_up.h"
@@ -206,6 +207,8 @@ AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, d
       stop);
   a.grid = std::move(grid);
   a.source_triangles = area_W.triangles.size();
+  static std::atomic<uint64_t> next_id{1};
+  a.id = next_id++;
   a.up_facing_share = upFacingShare(area_W, -gravity_W);
   return a;
 }

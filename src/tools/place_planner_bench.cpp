@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+#include "place_planner/cuda_backend.h"
 #include "place_planner/floor_points.h"
 #include "place_planner/mesh_io.h"
 #include "place_planner/planner.h"
@@ -61,7 +62,12 @@ double spacingFor(const Mesh& area) {
 }
 
 void runPlan(benchmark::State& state, const std::string& area_file, bool cold,
-             OrientationMode mode = OrientationMode::kAuto) {
+             OrientationMode mode = OrientationMode::kAuto, BackendKind backend = BackendKind::kCpu) {
+  std::string why;
+  if (backend == BackendKind::kCuda && !cuda::available(&why)) {
+    state.SkipWithError(("no usable GPU: " + why).c_str());
+    return;
+  }
   const int tris = static_cast<int>(state.range(0));
   const Mesh* object = tris >= 1000 ? mesh("objects/mug_ycb025_1k.ply")
                                     : mesh(std::to_string(tris) + "@objects/mug_ycb025.ply");
@@ -75,6 +81,7 @@ void runPlan(benchmark::State& state, const std::string& area_file, bool cold,
   cfg.threads = 2;
   cfg.max_rotations = 5;
   cfg.orientation = mode;
+  cfg.backend = backend;
   static const Planner planner;  // keeps the area's model between iterations (warm runs)
   PlanResult r;
   StepTimes sum;
@@ -115,6 +122,13 @@ void BM_BooksStackCold(benchmark::State& s) { runPlan(s, "areas/books_stack.ply"
 void BM_BooksStackPrincipalAxis(benchmark::State& s) {
   runPlan(s, "areas/books_stack.ply", true, OrientationMode::kPrincipalAxis);
 }
+// The same workloads on the GPU (per-kernel times in the counters, as for the CPU).
+void BM_BooksStackCudaCold(benchmark::State& s) {
+  runPlan(s, "areas/books_stack.ply", true, OrientationMode::kAuto, BackendKind::kCuda);
+}
+void BM_BooksStackCudaPrincipalAxis(benchmark::State& s) {
+  runPlan(s, "areas/books_stack.ply", true, OrientationMode::kPrincipalAxis, BackendKind::kCuda);
+}
 void BM_DishRackWarm(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", false); }
 void BM_DishRackCold(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", true); }
 
@@ -123,6 +137,8 @@ void BM_DishRackCold(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", tr
 BENCHMARK(BM_BooksStackWarm)->Arg(200)->Arg(500)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BooksStackCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_BooksStackPrincipalAxis)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BooksStackCudaCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BooksStackCudaPrincipalAxis)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DishRackWarm)->Arg(200)->Arg(500)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DishRackCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -44,7 +44,7 @@ void validate(const PlannerConfig& c) {
           c.grid_cell_size, ">= 0, 0 = derived");
   require(std::isfinite(c.time_budget_ms) && c.time_budget_ms >= 0, "time_budget_ms",
           c.time_budget_ms, ">= 0, 0 = none");
-  require(c.max_candidates >= 1, "max_candidates", c.max_candidates, ">= 1");
+  require(c.max_candidates >= 1 && c.max_candidates <= 100000, "max_candidates", c.max_candidates, "1 .. 100000");
   require(c.threads >= 0 && c.threads <= 256, "threads", c.threads, "0 .. 256, 0 = all");
   require(c.max_local_optimisation_steps >= 0 && c.max_local_optimisation_steps <= 50,
           "max_local_optimisation_steps", c.max_local_optimisation_steps, "0 .. 50");

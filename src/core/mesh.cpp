@@ -15,14 +15,15 @@ namespace {
 // resolution has features well above 1e-6 of its size.
 constexpr double kPlanarityTol = 1e-6;
 constexpr double kZeroAreaTol = 1e-12;  // area relative to diag^2
+// Coordinates beyond are refused: squared lengths of 1e77 overflow, and no scene is this big.
+constexpr double kMaxCoordinate = 1e12;
 
 Eigen::Vector3d newellNormal(const std::vector<Eigen::Vector3d>& v, const std::vector<int>& poly) {
+  // Summed relative to the first vertex: from absolute coordinates, a mesh far from the origin
+  // for its size carries rounding of |p| * size * eps that makes degenerate polygons look real.
+  const Eigen::Vector3d& o = v[poly[0]];
   Eigen::Vector3d n = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const Eigen::Vector3d& a = v[poly[i]];
-    const Eigen::Vector3d& b = v[poly[(i + 1) % poly.size()]];
-    n += (a - b).cross(a + b) * 0.5;  // twice-area vector / 2 = area vector
-  }
+  for (size_t i = 1; i + 1 < poly.size(); ++i) n += (v[poly[i]] - o).cross(v[poly[i + 1]] - o);
   return n * 0.5;  // area-weighted normal: |n| = polygon area when planar
 }
 
@@ -95,10 +96,11 @@ Mesh buildMesh(const std::vector<Eigen::Vector3d>& vertices,
   for (int i = 0; i < nv; ++i) {
     const Eigen::Vector3d& p = vertices[i];
     for (int k = 0; k < 3; ++k) {
-      if (!std::isfinite(p[k])) {
+      if (!std::isfinite(p[k]) || std::abs(p[k]) > kMaxCoordinate) {
         std::ostringstream os;
-        os << name << ": vertex " << i << " has a non-finite coordinate (" << "xyz"[k] << " = "
-           << p[k] << ")";
+        os << name << ": vertex " << i << " has a "
+           << (std::isfinite(p[k]) ? "coordinate beyond 1e12 m" : "non-finite coordinate") << " (" << "xyz"[k]
+           << " = " << p[k] << ")";
         throw MeshError(os.str());
       }
     }

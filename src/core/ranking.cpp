@@ -90,7 +90,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
   auto placeable = [&](Item& it) {
     if (!place || it.placement.checked) return it.placement.blocked.empty();
     // Bounded work: when the gripper blocks pose after pose, the search for more stops.
-    if (++place_checks > 10 * config.max_candidates) return false;
+    if (++place_checks > 10L * config.max_candidates) return false;
     it.placement = place(it.leaf);
     if (it.placement.blocked.empty()) return true;
     if (stats) ++stats->gripper_rejected;
@@ -102,7 +102,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     int robust = 0, checked = 0;
     size_t next = 0;
     // Bounded work: at most four times max_candidates leaves are checked.
-    while (robust < config.max_candidates && checked < 4 * config.max_candidates) {
+    while (robust < config.max_candidates && checked < 4L * config.max_candidates) {
       std::vector<size_t> batch, where;
       for (; next < distinct.size() && batch.size() < static_cast<size_t>(config.max_candidates - robust); ++next)
         if (distinct[next].stable && placeable(distinct[next])) {

@@ -41,6 +41,9 @@ if(CATKIN_ENABLE_TESTING)
   target_compile_definitions(place_planner_node_test PRIVATE
     PP_NODE_BINARY="$<TARGET_FILE:place_planner_node>")
 
+  # The soak (scripts/soak, python): the short form, 60 goals of every kind.
+  add_rostest(test/ros/soak.test DEPENDENCIES place_planner_node)
+
   # prepareGoal without a node: a plain gtest, no roscore (goal -> core conversion, frames,
   # overrides, errors naming the field).
   catkin_add_gtest(prepare_goal_tests test/ros/test_prepare_goal.cpp)

@@ -44,6 +44,9 @@ if(CATKIN_ENABLE_TESTING)
   # The soak (scripts/soak, python): the short form, 60 goals of every kind.
   add_rostest(test/ros/soak.test DEPENDENCIES place_planner_node)
 
+  # launch/place_planner.launch respawns a killed node (test_respawn.py).
+  add_rostest(test/ros/respawn.test DEPENDENCIES place_planner_node)
+
   # prepareGoal without a node: a plain gtest, no roscore (goal -> core conversion, frames,
   # overrides, errors naming the field).
   catkin_add_gtest(prepare_goal_tests test/ros/test_prepare_goal.cpp)

@@ -84,7 +84,7 @@ void PlacePlannerNode::onGoal(GoalHandle goal) {
     std::lock_guard<std::mutex> lock(goal_mutex_);
     superseded.swap(pending_);
     pending_ = goal;
-    if (running_) preempt_requested_ = true;  // the newest goal wins
+    if (running_) requestPreempt();  // the newest goal wins
   }
   goal_cv_.notify_all();
   if (superseded) {
@@ -99,10 +99,15 @@ void PlacePlannerNode::onCancel(GoalHandle goal) {
     if (pending_ && *pending_ == goal) {
       recalled.swap(pending_);
     } else if (running_ && *running_ == goal) {
-      preempt_requested_ = true;
+      requestPreempt();
     }
   }
   if (recalled) recalled->setCanceled(preemptedResult("recalled: cancelled before it started"));
+}
+
+void PlacePlannerNode::requestPreempt() {
+  if (!preempt_requested_) preempt_time_ = ros::WallTime::now();
+  preempt_requested_ = true;
 }
 
 void PlacePlannerNode::goalLoop() {
@@ -116,6 +121,7 @@ void PlacePlannerNode::goalLoop() {
       pending_.reset();
       running_ = goal;
       preempt_requested_ = false;
+      preempt_time_ = ros::WallTime();
     }
     // A cancel that came between the two is already a preempt request (onCancel sees running_).
     goal.setAccepted("accepted by place_planner");
@@ -261,11 +267,22 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   budget << "time budget of " << prepared.config.time_budget_ms / 1000.0 << " s used up";
   // PlanResult::outcome() decides; the codes keep their numbers.
   switch (plan.outcome()) {
-    case PlanOutcome::kCancelled:
+    case PlanOutcome::kCancelled: {
+      // How long the planner took to stop: what a caller waits for after its cancel.
+      ros::WallTime asked;
+      {
+        std::lock_guard<std::mutex> lock(goal_mutex_);
+        asked = preempt_time_;
+      }
+      if (!asked.isZero()) {
+        summary << "; stopped " << static_cast<int>(1e3 * (ros::WallTime::now() - asked).toSec() + 0.5)
+                << " ms after the cancel or newer goal";
+      }
       result.error_code = Result::PREEMPTED;
       result.error_message = "preempted: " + summary.str();
       answer->terminal = Terminal::kCanceled;
       break;
+    }
     case PlanOutcome::kTimedOutWithStable:
       // A partial answer is still an answer: SUCCESS, flagged.
       result.error_code = Result::SUCCESS;

@@ -351,6 +351,7 @@ TEST(PlacePlannerNode, CancelEndsGoalQuicklyWithCandidatesSoFar) {
   EXPECT_EQ(client().getState(), actionlib::SimpleClientGoalState::PREEMPTED);
   const Result r = *client().getResult();
   EXPECT_EQ(r.error_code, Result::PREEMPTED) << r.error_message;
+  std::printf("[test 5] %s\n", r.error_message.c_str());
   const auto items = log.copy();
   ASSERT_FALSE(items.empty());
   EXPECT_LT(r.floor_points_evaluated, items.back().second.floor_points_total) << "it was not cut short";

@@ -86,6 +86,8 @@ class PlacePlannerNode {
   bool stopping_ = false;
   // Cancel or a newer goal: the running goal's planner stops at its next step.
   std::atomic<bool> preempt_requested_{false};
+  ros::WallTime preempt_time_;  // when it was requested (goal_mutex_)
+  void requestPreempt();        // with goal_mutex_ held
 
   std::unique_ptr<Server> server_;
   std::thread goal_thread_;

@@ -8,6 +8,7 @@ add_library(place_planner_ros STATIC
   src/node/markers.cpp
   src/node/params.cpp
   src/node/prepare_goal.cpp
+  src/node/place_plan_server.cpp
   src/node/place_planner_node.cpp)
 target_include_directories(place_planner_ros PUBLIC
   ${PROJECT_SOURCE_DIR}/include ${CATKIN_DEVEL_PREFIX}/include ${catkin_INCLUDE_DIRS})
@@ -52,6 +53,11 @@ if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(prepare_goal_tests test/ros/test_prepare_goal.cpp)
   target_link_libraries(prepare_goal_tests place_planner_ros)
   target_compile_options(prepare_goal_tests PRIVATE ${PP_WARN})
+
+  # The result guard of PlacePlanServer, no roscore.
+  catkin_add_gtest(place_plan_server_tests test/ros/test_place_plan_server.cpp)
+  target_link_libraries(place_plan_server_tests place_planner_ros)
+  target_compile_options(place_plan_server_tests PRIVATE ${PP_WARN})
 
   # The command-line tool's exit codes and outcome line (no ROS master needed): it runs the
   # built binary.

@@ -1,4 +1,5 @@
-// The place_planner node: init, construct, spin. Bad parameters: the node names them and exits 1.
+// The place_planner node: init, construct, spin. Bad parameters: the node names them and exits 1;
+// any other exception out of the node: exits 2, naming it.
 #include "place_planner/ros/place_planner_node.h"
 
 int main(int argc, char** argv) {
@@ -11,6 +12,11 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     ROS_FATAL("place_planner: %s; not starting", e.what());
     return 1;
+  } catch (const std::exception& e) {
+    // Goals never get here (each is answered INTERNAL_ERROR); this is the node itself failing,
+    // said before launch/place_planner.launch respawns it.
+    ROS_FATAL("place_planner: %s; exiting", e.what());
+    return 2;
   }
   return 0;
 }

@@ -55,8 +55,7 @@ PlacePlannerNode::PlacePlannerNode(const ros::NodeHandle& nh, const ros::NodeHan
                                         [this](const ros::WallTimerEvent&) { onFeedbackTimer(); });
   goal_thread_ = std::thread([this] { goalLoop(); });
   server_ = std::make_unique<Server>(
-      pnh_, "place_plan", [this](GoalHandle g) { onGoal(g); }, [this](GoalHandle g) { onCancel(g); },
-      false);
+      pnh_, "place_plan", [this](GoalHandle g) { onGoal(g); }, [this](GoalHandle g) { onCancel(g); });
   server_->start();
   ROS_INFO("place_planner: serving %s/place_plan, planning frame '%s'",
            pnh_.getNamespace().c_str(), config_.planning_frame.c_str());

@@ -461,6 +461,51 @@ TEST(PlacePlannerNode, SupersededOrCancelledWaitingGoalIsPreemptedNeverSuccess) 
   EXPECT_EQ(a.getResult()->error_code, Result::PREEMPTED);
 }
 
+// ---------------------------------------------------------------- 5c'
+// A cancel that overtakes its goal (two topics): actionlib answers the goal itself, RECALLED,
+// with a default result, which PlacePlanServer's guard turns into PREEMPTED. Sent as raw
+// messages so that the cancel comes first every time.
+TEST(PlacePlannerNode, CancelThatOvertakesItsGoalIsPreemptedNotSuccess) {
+  ros::NodeHandle nh;
+  ros::Publisher cancel_pub = nh.advertise<actionlib_msgs::GoalID>(std::string(kAction) + "/cancel", 1);
+  ros::Publisher goal_pub = nh.advertise<PlacePlanActionGoal>(std::string(kAction) + "/goal", 1);
+  std::mutex mutex;
+  std::vector<PlacePlanActionResult> results;
+  ros::Subscriber sub = nh.subscribe<PlacePlanActionResult>(
+      std::string(kAction) + "/result", 10, [&](const PlacePlanActionResultConstPtr& r) {
+        std::lock_guard<std::mutex> lock(mutex);
+        results.push_back(*r);
+      });
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(10.0);
+  while ((cancel_pub.getNumSubscribers() == 0 || goal_pub.getNumSubscribers() == 0 ||
+          sub.getNumPublishers() == 0) && ros::WallTime::now() < give_up) {
+    ros::WallDuration(0.01).sleep();
+  }
+  ASSERT_GT(goal_pub.getNumSubscribers(), 0u);
+  const std::string id = "cancel-first-" + std::to_string(ros::WallTime::now().toNSec());
+  actionlib_msgs::GoalID cancel;
+  cancel.id = id;
+  cancel_pub.publish(cancel);
+  ros::WallDuration(0.3).sleep();  // the cancel is in before the goal
+  PlacePlanActionGoal goal;
+  goal.goal_id.id = id;
+  goal.goal_id.stamp = ros::Time::now();
+  goal.goal = boxOnPlaneGoalForCuda();
+  goal_pub.publish(goal);
+  const PlacePlanActionResult* mine = nullptr;
+  for (int i = 0; i < 200 && !mine; ++i) {
+    ros::WallDuration(0.01).sleep();
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& r : results) {
+      if (r.status.goal_id.id == id) mine = &r;
+    }
+  }
+  ASSERT_NE(mine, nullptr) << "no result for the overtaken goal";
+  EXPECT_EQ(mine->status.status, actionlib_msgs::GoalStatus::RECALLED);
+  EXPECT_EQ(mine->result.error_code, Result::PREEMPTED) << mine->result.error_message;
+  EXPECT_EQ(mine->result.error_message.rfind("recalled by actionlib", 0), 0u) << mine->result.error_message;
+}
+
 // ---------------------------------------------------------------- 5d
 // A planner exception is INTERNAL_ERROR with its message, and the node serves on. The second
 // node of place_planner_node.test has backend: cuda; where no GPU answers, the core's plan()

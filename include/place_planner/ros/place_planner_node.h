@@ -7,9 +7,10 @@
 // header.frame_id when that is set (tf2 -> W, then object_pose^-1 -> O) and in O when it is empty.
 //
 // One goal runs at a time; the newest goal wins (SimpleActionServer's policy). The goal queue is
-// the node's own, over actionlib::ActionServer, so that every goal that does not run to the end
-// is answered with a PREEMPTED result of its own: SimpleActionServer answers a goal it drops
-// before it starts (RECALLED) with a default result, whose error_code 0 reads as SUCCESS.
+// the node's own, over PlacePlanServer (actionlib's ActionServer with a guard on results), so
+// that every goal that does not run to the end is answered with a PREEMPTED result of its own:
+// SimpleActionServer answers a goal it drops before it starts (RECALLED) with a default result,
+// whose error_code 0 reads as SUCCESS.
 #pragma once
 #include <atomic>
 #include <condition_variable>
@@ -19,7 +20,6 @@
 #include <string>
 #include <thread>
 
-#include <actionlib/server/action_server.h>
 #include <pcl_msgs/PolygonMesh.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
@@ -28,6 +28,7 @@
 #include "place_planner/PlacePlanAction.h"
 #include "place_planner/planner.h"
 #include "place_planner/ros/params.h"
+#include "place_planner/ros/place_plan_server.h"
 #include "place_planner/ros/prepare_goal.h"
 
 namespace place_planner {
@@ -41,7 +42,7 @@ class PlacePlannerNode {
   ~PlacePlannerNode();
 
  private:
-  using Server = actionlib::ActionServer<PlacePlanAction>;
+  using Server = PlacePlanServer;
   using GoalHandle = Server::GoalHandle;
   enum class Terminal { kSucceeded, kAborted, kCanceled };
   struct Answer;  // the result of one goal and the state to end it in

@@ -57,6 +57,8 @@ class PlacePlannerNode {
   void plan(const PlacePlanGoal& goal, Answer* answer);
   // X_WF: pose of `frame` in the planning frame (tf2, waiting up to ~tf_timeout).
   Eigen::Isometry3d lookup(const std::string& frame) const;
+  // Between goals: freed heap back to the OS, so that the resident size is what the node holds.
+  static void releaseFreedMemory();
   bool onProgress(const Progress& progress);
   void onFeedbackTimer();
   // Publishes when feedback_period has passed since the last feedback.

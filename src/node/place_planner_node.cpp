@@ -134,42 +134,44 @@ void PlacePlannerNode::goalLoop() {
       preempt_requested_ = false;
       preempt_time_ = ros::WallTime();
     }
-    // A cancel that came between the two is already a preempt request (onCancel sees running_).
-    goal.setAccepted("accepted by place_planner");
-    const ros::WallTime start = ros::WallTime::now();
-    Answer answer = execute(*goal.getGoal());
-    answer.result.planning_time = (ros::WallTime::now() - start).toSec();
-    {
-      std::lock_guard<std::mutex> lock(goal_mutex_);
-      running_.reset();
-    }
-    const Result& r = answer.result;
-    switch (answer.terminal) {
-      case Terminal::kSucceeded: goal.setSucceeded(r, r.error_message); break;
-      case Terminal::kCanceled: goal.setCanceled(r, r.error_message); break;
-      case Terminal::kAborted: goal.setAborted(r, r.error_message); break;
-    }
-    if (!answer.planned) {
-      releaseFreedMemory();
-      continue;
-    }
-    // Visualisation after the answer, so it does not delay the caller.
-    try {
-      MarkerOptions options;
-      options.frame_id = config_.planning_frame;
-      options.stamp = answer.stamp;
-      options.max_candidates = config_.marker_candidates;
-      options.text_count = config_.marker_text_count;
-      marker_pub_.publish(buildMarkers(answer.prepared.object_O, answer.prepared.area_W, answer.plan, options));
-      geometry_msgs::PoseArray poses;
-      poses.header.frame_id = config_.planning_frame;
-      poses.header.stamp = answer.stamp;
-      for (const auto& c : r.candidates) poses.poses.push_back(c.pose.pose);
-      candidates_pub_.publish(poses);
-    } catch (const std::exception& e) {
-      ROS_ERROR("place_planner: markers of the last goal failed: %s", e.what());
-    }
+    serve(goal);
+    // After serve(): the goal's meshes, models and answer are gone by now.
     releaseFreedMemory();
+  }
+}
+
+void PlacePlannerNode::serve(GoalHandle goal) {
+  // A cancel that came since it was taken is already a preempt request (onCancel sees running_).
+  goal.setAccepted("accepted by place_planner");
+  const ros::WallTime start = ros::WallTime::now();
+  Answer answer = execute(*goal.getGoal());
+  answer.result.planning_time = (ros::WallTime::now() - start).toSec();
+  {
+    std::lock_guard<std::mutex> lock(goal_mutex_);
+    running_.reset();
+  }
+  const Result& r = answer.result;
+  switch (answer.terminal) {
+    case Terminal::kSucceeded: goal.setSucceeded(r, r.error_message); break;
+    case Terminal::kCanceled: goal.setCanceled(r, r.error_message); break;
+    case Terminal::kAborted: goal.setAborted(r, r.error_message); break;
+  }
+  if (!answer.planned) return;
+  // Visualisation after the answer, so it does not delay the caller.
+  try {
+    MarkerOptions options;
+    options.frame_id = config_.planning_frame;
+    options.stamp = answer.stamp;
+    options.max_candidates = config_.marker_candidates;
+    options.text_count = config_.marker_text_count;
+    marker_pub_.publish(buildMarkers(answer.prepared.object_O, answer.prepared.area_W, answer.plan, options));
+    geometry_msgs::PoseArray poses;
+    poses.header.frame_id = config_.planning_frame;
+    poses.header.stamp = answer.stamp;
+    for (const auto& c : r.candidates) poses.poses.push_back(c.pose.pose);
+    candidates_pub_.publish(poses);
+  } catch (const std::exception& e) {
+    ROS_ERROR("place_planner: markers of the last goal failed: %s", e.what());
   }
 }
 

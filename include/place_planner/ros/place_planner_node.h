@@ -52,6 +52,8 @@ class PlacePlannerNode {
   void onCancel(GoalHandle goal);
   // The goal thread: takes the newest pending goal, runs it, ends it; until shutdown.
   void goalLoop();
+  // Accepts, runs and ends one goal, then publishes its markers; never throws.
+  void serve(GoalHandle goal);
   // One goal, start to answer; never throws (an exception is INTERNAL_ERROR).
   Answer execute(const PlacePlanGoal& goal);
   void plan(const PlacePlanGoal& goal, Answer* answer);

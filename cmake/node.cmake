@@ -7,6 +7,8 @@ add_library(place_planner_ros STATIC
   src/node/conversions.cpp
   src/node/markers.cpp
   src/node/params.cpp
+  src/node/prepare_goal.cpp
+  src/node/place_plan_server.cpp
   src/node/place_planner_node.cpp)
 target_include_directories(place_planner_ros PUBLIC
   ${PROJECT_SOURCE_DIR}/include ${CATKIN_DEVEL_PREFIX}/include ${catkin_INCLUDE_DIRS})
@@ -39,6 +41,23 @@ if(CATKIN_ENABLE_TESTING)
   # The test starts the node itself once, with a bad parameter, to see it refuse.
   target_compile_definitions(place_planner_node_test PRIVATE
     PP_NODE_BINARY="$<TARGET_FILE:place_planner_node>")
+
+  # The soak (scripts/soak, python): the short form, 60 goals of every kind.
+  add_rostest(test/ros/soak.test DEPENDENCIES place_planner_node)
+
+  # launch/place_planner.launch respawns a killed node (test_respawn.py).
+  add_rostest(test/ros/respawn.test DEPENDENCIES place_planner_node)
+
+  # prepareGoal without a node: a plain gtest, no roscore (goal -> core conversion, frames,
+  # overrides, errors naming the field).
+  catkin_add_gtest(prepare_goal_tests test/ros/test_prepare_goal.cpp)
+  target_link_libraries(prepare_goal_tests place_planner_ros)
+  target_compile_options(prepare_goal_tests PRIVATE ${PP_WARN})
+
+  # The result guard of PlacePlanServer, no roscore.
+  catkin_add_gtest(place_plan_server_tests test/ros/test_place_plan_server.cpp)
+  target_link_libraries(place_plan_server_tests place_planner_ros)
+  target_compile_options(place_plan_server_tests PRIVATE ${PP_WARN})
 
   # The command-line tool's exit codes and outcome line (no ROS master needed): it runs the
   # built binary.

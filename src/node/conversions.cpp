@@ -146,9 +146,14 @@ void toMsg(const Candidate& c, const std::string& frame_id, const ros::Time& sta
   msg->pose.header.frame_id = frame_id;
   msg->pose.header.stamp = stamp;
   toMsg(c.X_WO, &msg->pose.pose);
-  msg->gripper_pose.header = msg->pose.header;
-  toMsg(X_OG ? Eigen::Isometry3d(c.X_WO * *X_OG) : Eigen::Isometry3d::Identity(),
-        &msg->gripper_pose.pose);
+  // Without a grasp there is no gripper pose: left empty (all zero) rather than an identity
+  // that a caller could mistake for one.
+  msg->has_gripper_pose = X_OG != nullptr;
+  msg->gripper_pose = geometry_msgs::PoseStamped();
+  if (X_OG) {
+    msg->gripper_pose.header = msg->pose.header;
+    toMsg(Eigen::Isometry3d(c.X_WO * *X_OG), &msg->gripper_pose.pose);
+  }
   msg->quality = c.quality;
   msg->stable = c.stable;
   msg->robust_share = c.robustness.share();

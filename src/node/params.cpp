@@ -1,6 +1,9 @@
 #include "place_planner/ros/params.h"
 
+#include <cmath>
 #include <stdexcept>
+
+#include <ros/console.h>
 
 #include <XmlRpcValue.h>
 
@@ -13,6 +16,7 @@ class ParamReader {
   explicit ParamReader(const ros::NodeHandle& nh) : nh_(nh) {}
 
   std::string fullName(const std::string& key) const { return nh_.resolveName(key); }
+  bool has(const std::string& key) const { return nh_.hasParam(key); }
 
   void read(const std::string& key, double* value) const {
     XmlRpc::XmlRpcValue v;
@@ -120,7 +124,24 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("robust_com_offset", &p.robust_com_offset);
   r.read("robust_min_share", &p.robust_min_share);
   r.read("robust_check", &p.robust_check);
-  r.read("time_budget_ms", &p.time_budget_ms);
+  // The budget is in seconds like every time of the ROS interface (doc/node.md, "Units"); the
+  // core's field is in ms. time_budget_ms (before issue 10) is still read, with a warning.
+  double budget_s = p.time_budget_ms / 1000.0;
+  r.read("time_budget_s", &budget_s);
+  if (r.has("time_budget_ms")) {
+    if (r.has("time_budget_s")) {
+      r.fail("time_budget_ms", "and time_budget_s are both set: keep time_budget_s (seconds)");
+    }
+    double budget_ms = p.time_budget_ms;
+    r.read("time_budget_ms", &budget_ms);
+    ROS_WARN("parameter %s is deprecated: use time_budget_s (seconds); read as %g s",
+             r.fullName("time_budget_ms").c_str(), budget_ms / 1000.0);
+    budget_s = budget_ms / 1000.0;
+  }
+  if (!(std::isfinite(budget_s) && budget_s >= 0)) {
+    r.fail("time_budget_s", "= " + std::to_string(budget_s) + " is out of range (>= 0 s, 0 = no budget)");
+  }
+  p.time_budget_ms = budget_s * 1000.0;
   r.read("max_candidates", &p.max_candidates);
   r.read("threads", &p.threads);
   r.read("max_local_optimisation_steps", &p.max_local_optimisation_steps);

@@ -2,6 +2,7 @@
 // goals through actionlib and checks the answer's geometry, not only that something came back.
 // Frames: W = world (the node's planning frame), S = sensor (a static transform this test
 // broadcasts), O = the object's mesh frame.
+#include <actionlib/client/action_client.h>
 #include <actionlib/client/simple_action_client.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -20,6 +21,7 @@
 #include "place_planner/PlacePlanAction.h"
 #include "place_planner/ros/conversions.h"
 #include "place_planner/ros/markers.h"
+#include "place_planner/cuda_backend.h"
 #include "place_planner/ros/params.h"
 #include "place_planner/scenes.h"
 
@@ -39,8 +41,9 @@ constexpr double kSameQuality = 0.03;
 constexpr double kExact = 1e-6;
 // A vertex resting on the area (the planner's contact tolerance is well below this).
 constexpr double kOnSurface = 2e-3;
-// Cancel must end the goal within 0.2 s (issue 4), measured at the client.
-constexpr double kCancelLatency = 0.2;
+// Cancel (or a newer goal) must end the running goal within 0.5 s (issue 10), measured at the
+// client on this 2-core machine while others build on it; measured: about 10 ms.
+constexpr double kCancelLatency = 0.5;
 // Feedback is promised every 100 ms; allow scheduling jitter on a loaded 2-core CI machine.
 constexpr double kFeedbackGap = 0.15;
 // sizeof(PlannerConfig) when the YAML was last brought in line with it (x86-64, g++ 12).
@@ -90,6 +93,14 @@ PlacePlanGoal longGoal() {
   goal.placement_area_mesh = meshMsg(longArea(), "world");
   goal.floor_point_spacing = 0.01;
   goal.max_candidates = 10;
+  return goal;
+}
+
+// A quick goal with inline meshes (for a node that has no topic meshes).
+PlacePlanGoal boxOnPlaneGoalForCuda() {
+  PlacePlanGoal goal = quickGoal();
+  goal.object_mesh = meshMsg(testObject(), "");
+  goal.placement_area_mesh = meshMsg(testArea(), "world");
   return goal;
 }
 
@@ -194,9 +205,13 @@ TEST(PlacePlannerNode, MeshesFromTopicsGiveStablePoseInPlanningFrame) {
   EXPECT_LT(distance(path.poses.back(), best.pose.pose), kExact);
   EXPECT_LT(angle(path.poses.back(), best.pose.pose), kExact);
   EXPECT_GT(path.poses.front().position.z, best.pose.pose.position.z);
-  // Without a grasp the gripper pose is the identity.
-  EXPECT_NEAR(best.gripper_pose.pose.orientation.w, 1.0, kExact);
-  EXPECT_NEAR(std::abs(best.gripper_pose.pose.position.z), 0.0, kExact);
+  // Without a grasp there is no gripper pose: flagged absent and empty, not the identity.
+  for (const auto& c : a.result.candidates) {
+    EXPECT_FALSE(c.has_gripper_pose);
+    EXPECT_EQ(c.gripper_pose.header.frame_id, "");
+    EXPECT_EQ(c.gripper_pose.pose.orientation.w, 0.0);
+    EXPECT_EQ(fromMsg(c.gripper_pose.pose.position).norm(), 0.0);
+  }
 }
 
 // ---------------------------------------------------------------- 2
@@ -336,6 +351,7 @@ TEST(PlacePlannerNode, CancelEndsGoalQuicklyWithCandidatesSoFar) {
   EXPECT_EQ(client().getState(), actionlib::SimpleClientGoalState::PREEMPTED);
   const Result r = *client().getResult();
   EXPECT_EQ(r.error_code, Result::PREEMPTED) << r.error_message;
+  std::printf("[test 5] %s\n", r.error_message.c_str());
   const auto items = log.copy();
   ASSERT_FALSE(items.empty());
   EXPECT_LT(r.floor_points_evaluated, items.back().second.floor_points_total) << "it was not cut short";
@@ -359,12 +375,166 @@ TEST(PlacePlannerNode, NewGoalPreemptsRunningOne) {
   PlacePlanGoal goal = quickGoal();
   goal.object_mesh = meshMsg(testObject(), "");
   goal.placement_area_mesh = meshMsg(testArea(), "world");
+  const ros::WallTime t0 = ros::WallTime::now();
   other.sendGoal(goal);
   ASSERT_TRUE(client().waitForResult(ros::Duration(5.0)));
+  const double latency = (ros::WallTime::now() - t0).toSec();
+  std::printf("[test 5b] preemption by a new goal: the running goal answered %.1f ms after it was sent\n",
+              latency * 1e3);
+  EXPECT_LT(latency, kCancelLatency);
   EXPECT_EQ(client().getState(), actionlib::SimpleClientGoalState::PREEMPTED);
   EXPECT_EQ(client().getResult()->error_code, Result::PREEMPTED);
   ASSERT_TRUE(other.waitForResult(ros::Duration(30.0)));
   EXPECT_EQ(other.getResult()->error_code, Result::SUCCESS) << other.getResult()->error_message;
+}
+
+// ---------------------------------------------------------------- 5c
+// Goals that never run to the end never read as SUCCESS: a goal superseded while it waits
+// (RECALLED) and a waiting goal that is cancelled answer PREEMPTED with a message saying so.
+// (SimpleActionServer answered both with a default result: error_code 0.)
+using MultiClient = actionlib::ActionClient<PlacePlanAction>;
+
+bool waitDone(const MultiClient::GoalHandle& g, double timeout) {
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (g.getCommState() != actionlib::CommState::DONE) {
+    if (ros::WallTime::now() > give_up) return false;
+    ros::WallDuration(0.002).sleep();
+  }
+  return true;
+}
+
+TEST(PlacePlannerNode, SupersededOrCancelledWaitingGoalIsPreemptedNeverSuccess) {
+  MultiClient ac(kAction);
+  ASSERT_TRUE(ac.waitForActionServerToStart(ros::Duration(10.0)));
+  PlacePlanGoal quick = quickGoal();
+  quick.object_mesh = meshMsg(testObject(), "");
+  quick.placement_area_mesh = meshMsg(testArea(), "world");
+  int recalled = 0, preempted_running = 0;
+  for (int round = 0; round < 5; ++round) {
+    // A runs; B and C come back to back on one connection: B waits and C supersedes it (or, should
+    // B have started in between, C preempts it while it runs).
+    MultiClient::GoalHandle a = ac.sendGoal(longGoal());
+    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(5.0);
+    while (a.getCommState() != actionlib::CommState::ACTIVE && ros::WallTime::now() < give_up) {
+      ros::WallDuration(0.002).sleep();
+    }
+    ASSERT_EQ(a.getCommState(), actionlib::CommState::ACTIVE);
+    MultiClient::GoalHandle b = ac.sendGoal(longGoal());
+    MultiClient::GoalHandle c = ac.sendGoal(quick);
+    ASSERT_TRUE(waitDone(a, 5.0));
+    ASSERT_TRUE(waitDone(b, 5.0));
+    ASSERT_TRUE(waitDone(c, 30.0));
+    EXPECT_EQ(a.getTerminalState().state_, actionlib::TerminalState::PREEMPTED);
+    ASSERT_TRUE(a.getResult());
+    EXPECT_EQ(a.getResult()->error_code, Result::PREEMPTED);
+    const auto b_state = b.getTerminalState().state_;
+    ASSERT_TRUE(b.getResult());
+    EXPECT_EQ(b.getResult()->error_code, Result::PREEMPTED) << b.getResult()->error_message;
+    if (b_state == actionlib::TerminalState::RECALLED) {
+      ++recalled;
+      EXPECT_EQ(b.getResult()->error_message.rfind("recalled: superseded", 0), 0u) << b.getResult()->error_message;
+    } else {
+      ++preempted_running;
+      EXPECT_EQ(b_state, actionlib::TerminalState::PREEMPTED);
+    }
+    EXPECT_EQ(c.getTerminalState().state_, actionlib::TerminalState::SUCCEEDED);
+    ASSERT_TRUE(c.getResult());
+    EXPECT_EQ(c.getResult()->error_code, Result::SUCCESS) << c.getResult()->error_message;
+  }
+  std::printf("[test 5c] superseded while waiting: %d recalled, %d preempted after they started\n",
+              recalled, preempted_running);
+  EXPECT_GT(recalled, 0) << "the waiting goal always started first: the test no longer tests recall";
+
+  // A waiting goal cancelled before it starts: RECALLED, PREEMPTED, the running one goes on.
+  MultiClient::GoalHandle a = ac.sendGoal(longGoal());
+  while (a.getCommState() != actionlib::CommState::ACTIVE) ros::WallDuration(0.002).sleep();
+  // B preempts A; cancelling B at once catches it waiting (or just started: then PREEMPTED).
+  MultiClient::GoalHandle b = ac.sendGoal(longGoal());
+  b.cancel();
+  ASSERT_TRUE(waitDone(a, 5.0));
+  ASSERT_TRUE(waitDone(b, 5.0));
+  ASSERT_TRUE(b.getResult());
+  EXPECT_EQ(b.getResult()->error_code, Result::PREEMPTED) << b.getResult()->error_message;
+  EXPECT_TRUE(b.getTerminalState().state_ == actionlib::TerminalState::RECALLED ||
+              b.getTerminalState().state_ == actionlib::TerminalState::PREEMPTED)
+      << b.getTerminalState().toString();
+  EXPECT_EQ(a.getResult()->error_code, Result::PREEMPTED);
+}
+
+// ---------------------------------------------------------------- 5c'
+// A cancel that overtakes its goal (two topics): actionlib answers the goal itself, RECALLED,
+// with a default result, which PlacePlanServer's guard turns into PREEMPTED. Sent as raw
+// messages so that the cancel comes first every time.
+TEST(PlacePlannerNode, CancelThatOvertakesItsGoalIsPreemptedNotSuccess) {
+  ros::NodeHandle nh;
+  ros::Publisher cancel_pub = nh.advertise<actionlib_msgs::GoalID>(std::string(kAction) + "/cancel", 1);
+  ros::Publisher goal_pub = nh.advertise<PlacePlanActionGoal>(std::string(kAction) + "/goal", 1);
+  std::mutex mutex;
+  std::vector<PlacePlanActionResult> results;
+  ros::Subscriber sub = nh.subscribe<PlacePlanActionResult>(
+      std::string(kAction) + "/result", 10, [&](const PlacePlanActionResultConstPtr& r) {
+        std::lock_guard<std::mutex> lock(mutex);
+        results.push_back(*r);
+      });
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(10.0);
+  while ((cancel_pub.getNumSubscribers() == 0 || goal_pub.getNumSubscribers() == 0 ||
+          sub.getNumPublishers() == 0) && ros::WallTime::now() < give_up) {
+    ros::WallDuration(0.01).sleep();
+  }
+  ASSERT_GT(goal_pub.getNumSubscribers(), 0u);
+  const std::string id = "cancel-first-" + std::to_string(ros::WallTime::now().toNSec());
+  actionlib_msgs::GoalID cancel;
+  cancel.id = id;
+  cancel_pub.publish(cancel);
+  ros::WallDuration(0.3).sleep();  // the cancel is in before the goal
+  PlacePlanActionGoal goal;
+  goal.goal_id.id = id;
+  goal.goal_id.stamp = ros::Time::now();
+  goal.goal = boxOnPlaneGoalForCuda();
+  goal_pub.publish(goal);
+  const PlacePlanActionResult* mine = nullptr;
+  for (int i = 0; i < 200 && !mine; ++i) {
+    ros::WallDuration(0.01).sleep();
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& r : results) {
+      if (r.status.goal_id.id == id) mine = &r;
+    }
+  }
+  ASSERT_NE(mine, nullptr) << "no result for the overtaken goal";
+  EXPECT_EQ(mine->status.status, actionlib_msgs::GoalStatus::RECALLED);
+  EXPECT_EQ(mine->result.error_code, Result::PREEMPTED) << mine->result.error_message;
+  EXPECT_EQ(mine->result.error_message.rfind("recalled by actionlib", 0), 0u) << mine->result.error_message;
+}
+
+// ---------------------------------------------------------------- 5d
+// A planner exception is INTERNAL_ERROR with its message, and the node serves on. The second
+// node of place_planner_node.test has backend: cuda; where no GPU answers, the core's plan()
+// throws "backend = cuda requested but unavailable" (planner.cpp).
+TEST(PlacePlannerNode, PlannerExceptionIsInternalErrorAndNodeServesOn) {
+  std::string why;
+  if (cuda::available(&why)) {
+    GTEST_SKIP() << "a GPU answers here, so backend cuda plans instead of throwing; this test "
+                    "needs a machine without one";
+  }
+  Client cuda_client("/place_planner_cuda/place_plan", true);
+  ASSERT_TRUE(cuda_client.waitForServer(ros::Duration(30.0)));
+  PlacePlanGoal goal = boxOnPlaneGoalForCuda();
+  for (int i = 0; i < 2; ++i) {  // twice: the node is still there after the first
+    cuda_client.sendGoal(goal);
+    ASSERT_TRUE(cuda_client.waitForResult(ros::Duration(30.0)));
+    const Result r = *cuda_client.getResult();
+    EXPECT_EQ(cuda_client.getState(), actionlib::SimpleClientGoalState::ABORTED);
+    EXPECT_EQ(r.error_code, Result::INTERNAL_ERROR) << r.error_message;
+    EXPECT_NE(r.error_message.find("backend = cuda requested but unavailable"), std::string::npos)
+        << r.error_message;
+    EXPECT_EQ(r.error_message.rfind("internal error: planner failed: ", 0), 0u) << r.error_message;
+    EXPECT_TRUE(r.candidates.empty());
+  }
+  // A bad goal there is still the goal's fault: INVALID_GOAL, not INTERNAL_ERROR.
+  goal.friction = -1;
+  cuda_client.sendGoal(goal);
+  ASSERT_TRUE(cuda_client.waitForResult(ros::Duration(30.0)));
+  EXPECT_EQ(cuda_client.getResult()->error_code, Result::INVALID_GOAL);
 }
 
 // ---------------------------------------------------------------- 6
@@ -455,6 +625,7 @@ TEST(PlacePlannerNode, GripperPoseIsPoseComposedWithGrasp) {
   ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
   ASSERT_FALSE(a.result.candidates.empty());
   for (const auto& c : a.result.candidates) {
+    EXPECT_TRUE(c.has_gripper_pose);
     EXPECT_EQ(c.gripper_pose.header.frame_id, c.pose.header.frame_id);
     geometry_msgs::Pose expected;
     toMsg(Eigen::Isometry3d(fromMsg(c.pose.pose) * X_OG), &expected);
@@ -504,7 +675,7 @@ void expectBudgetAnswer(const Answer& a) {
 
 TEST(PlacePlannerNode, TimeBudgetEndsLongPlanWithPartialAnswerOrTimedOut) {
   PlacePlanGoal goal = longGoal();
-  goal.time_budget = 0.3;  // s; the long plan needs several
+  goal.time_budget_s = 0.3;  // the long plan needs several seconds
   const ros::WallTime t0 = ros::WallTime::now();
   const Answer a = send(goal);
   const double wall = (ros::WallTime::now() - t0).toSec();
@@ -531,7 +702,7 @@ PlacePlanGoal boxOnPlaneGoal() {
 TEST(PlacePlannerNode, TinyBudgetIsTimedOutOrPartialNeverElse) {
   PlacePlanGoal goal = longGoal();
   goal.orientation_mode = "principal_axis";
-  goal.time_budget = 0.001;  // s
+  goal.time_budget_s = 0.001;
   expectBudgetAnswer(send(goal));
   goal.verify_top_k = 3;  // the budget is spent: nothing is simulated
   const Answer a = send(goal);
@@ -554,6 +725,22 @@ TEST(PlacePlannerNode, SteepSlopeWithLowFrictionIsNoStablePose) {
     EXPECT_FALSE(c.stable);
     EXPECT_FALSE(c.physics_checked);
   }
+}
+
+// A flagged 0 reaches the planner as 0: on a 5 degree slope (tan 5 deg = 0.087) the box rests
+// with the parameter's mu = 0.2 and slides with use_friction and friction 0.
+TEST(PlacePlannerNode, FlaggedZeroFrictionIsPlannedAsZero) {
+  PlacePlanGoal goal = boxOnPlaneGoal();
+  goal.placement_area_mesh = meshMsg(scenes::plane(0.6, 0.6, 5.0), "world");
+  goal.friction = 0.0;  // not flagged: the parameter
+  Answer a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  ASSERT_FALSE(a.result.candidates.empty());
+  EXPECT_TRUE(a.result.candidates.front().stable);
+  goal.use_friction = true;
+  a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::NO_STABLE_POSE) << a.result.error_message;
+  for (const auto& c : a.result.candidates) EXPECT_FALSE(c.stable);
 }
 
 // verify_top_k = 2: Bullet checks the best two stable candidates (a box on a face of the plane
@@ -627,6 +814,26 @@ TEST(PlacePlannerParams, OutOfRangeAndWrongTypeAreNamed) {
     EXPECT_NE(std::string(e.what()).find("/params_test/robust_check"), std::string::npos) << e.what();
   }
   nh.setParam("robust_check", false);
+  // The budget is in seconds; the deprecated time_budget_ms is still read, but not both.
+  nh.setParam("time_budget_s", -1.0);
+  try {
+    loadNodeConfig(nh);
+    ADD_FAILURE() << "time_budget_s -1 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/params_test/time_budget_s"), std::string::npos) << e.what();
+  }
+  nh.setParam("time_budget_s", 0.25);
+  EXPECT_DOUBLE_EQ(loadNodeConfig(nh).planner.time_budget_ms, 250.0);
+  nh.setParam("time_budget_ms", 300.0);
+  try {
+    loadNodeConfig(nh);
+    ADD_FAILURE() << "time_budget_s and time_budget_ms both accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/params_test/time_budget_ms"), std::string::npos) << e.what();
+  }
+  nh.deleteParam("time_budget_s");
+  EXPECT_DOUBLE_EQ(loadNodeConfig(nh).planner.time_budget_ms, 300.0);
+  nh.deleteParam("time_budget_ms");
   nh.setParam("robust_shift", 0.004);
   nh.setParam("orientation", std::string("keep"));
   const NodeConfig c = loadNodeConfig(nh);
@@ -649,7 +856,7 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
        {"gravity", "approach", "friction", "floor_point_spacing", "min_floor_points", "lowest_n",
         "max_rotations", "sphere_radius", "grid_cell_size", "orientation", "max_resting_faces",
         "robust_shift", "robust_tilt_deg", "robust_com_offset", "robust_min_share", "robust_check",
-        "time_budget_ms", "verify_top_k",
+        "time_budget_s", "verify_top_k",
         "max_candidates", "threads", "max_local_optimisation_steps", "min_support_width", "min_tipping_angle_deg",
         "min_quality", "merge_distance", "merge_angle_deg", "backend", "region_min", "region_max",
         "planning_frame", "tf_timeout", "feedback_period", "marker_candidates",

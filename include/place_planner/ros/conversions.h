@@ -40,7 +40,8 @@ void toMsg(const Eigen::Vector3d& v, geometry_msgs::Point* msg);
 void toMsg(const Eigen::Vector3d& v, geometry_msgs::Vector3* msg);
 
 // One candidate, all in frame_id (the planning frame W). X_OG: the grasp (gripper pose in the
-// object frame) (optional); gripper_pose = X_WO * X_OG when given, identity otherwise.
+// object frame) (optional); when given, gripper_pose = X_WO * X_OG and has_gripper_pose =
+// true; otherwise has_gripper_pose = false and gripper_pose is all zero (frame_id empty).
 void toMsg(const Candidate& candidate, const std::string& frame_id, const ros::Time& stamp,
            const Eigen::Isometry3d* X_OG, PlacementCandidate* msg);
 

@@ -1,6 +1,7 @@
 // Node parameters: PlannerConfig (include/place_planner/config.h) field for field, plus the few
 // settings that only the ROS layer has (voxblox_ros/ros_params.h style). config/place_planner.yaml
-// mirrors both structs; a missing parameter keeps the struct default.
+// mirrors both structs; a missing parameter keeps the struct default. Times are in seconds
+// (time_budget_s; the struct's time_budget_ms is filled from it).
 #pragma once
 #include <string>
 

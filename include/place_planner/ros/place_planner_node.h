@@ -1,16 +1,25 @@
 // The place_planner ROS 1 node: a thin adapter over place_planner::Planner.
-//   action server  ~place_plan   (place_planner/PlacePlan; goals run on actionlib's own thread)
+//   action server  ~place_plan   (place_planner/PlacePlan; goals run on a thread of their own)
 //   subscribes     object_mesh, placement_area_mesh   (pcl_msgs/PolygonMesh, remappable)
 //   publishes      ~markers (visualization_msgs/MarkerArray, latched), ~candidates (PoseArray, latched)
 // Frames (doc/node.md): W = ~planning_frame. The placement area mesh is brought into W by tf2.
 // The object's mesh frame O is located by goal.object_pose; the object mesh's vertices are in
 // header.frame_id when that is set (tf2 -> W, then object_pose^-1 -> O) and in O when it is empty.
+//
+// One goal runs at a time; the newest goal wins (SimpleActionServer's policy). The goal queue is
+// the node's own, over PlacePlanServer (actionlib's ActionServer with a guard on results), so
+// that every goal that does not run to the end is answered with a PREEMPTED result of its own:
+// SimpleActionServer answers a goal it drops before it starts (RECALLED) with a default result,
+// whose error_code 0 reads as SUCCESS.
 #pragma once
+#include <atomic>
+#include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 
-#include <actionlib/server/simple_action_server.h>
 #include <pcl_msgs/PolygonMesh.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
@@ -19,6 +28,8 @@
 #include "place_planner/PlacePlanAction.h"
 #include "place_planner/planner.h"
 #include "place_planner/ros/params.h"
+#include "place_planner/ros/place_plan_server.h"
+#include "place_planner/ros/prepare_goal.h"
 
 namespace place_planner {
 
@@ -27,15 +38,29 @@ class PlacePlannerNode {
   // Loads and validates the parameters from pnh: throws std::invalid_argument naming the bad one
   // before anything is advertised.
   PlacePlannerNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+  // Stops the running goal (answered PREEMPTED) and the goal thread.
+  ~PlacePlannerNode();
 
  private:
-  struct Prepared;  // a goal converted for the core: meshes, config, grasp
+  using Server = PlacePlanServer;
+  using GoalHandle = Server::GoalHandle;
+  enum class Terminal { kSucceeded, kAborted, kCanceled };
+  struct Answer;  // the result of one goal and the state to end it in
 
-  void execute(const PlacePlanGoalConstPtr& goal);
-  Prepared prepare(const PlacePlanGoal& goal);
-  // X_WF: pose of `frame` in the planning frame (identity for "" and the planning frame itself).
-  // Throws a TF_ERROR naming `what` and the frame.
-  Eigen::Isometry3d lookup(const std::string& frame, const std::string& what) const;
+  // actionlib's callbacks (ROS callback thread).
+  void onGoal(GoalHandle goal);
+  void onCancel(GoalHandle goal);
+  // The goal thread: takes the newest pending goal, runs it, ends it; until shutdown.
+  void goalLoop();
+  // Accepts, runs and ends one goal, then publishes its markers; never throws.
+  void serve(GoalHandle goal);
+  // One goal, start to answer; never throws (an exception is INTERNAL_ERROR).
+  Answer execute(const PlacePlanGoal& goal);
+  void plan(const PlacePlanGoal& goal, Answer* answer);
+  // X_WF: pose of `frame` in the planning frame (tf2, waiting up to ~tf_timeout).
+  Eigen::Isometry3d lookup(const std::string& frame) const;
+  // Between goals: freed heap back to the OS, so that the resident size is what the node holds.
+  static void releaseFreedMemory();
   bool onProgress(const Progress& progress);
   void onFeedbackTimer();
   // Publishes when feedback_period has passed since the last feedback.
@@ -58,8 +83,19 @@ class PlacePlannerNode {
   Progress progress_;
   ros::WallTime plan_start_, last_feedback_;
 
-  // Last: it starts serving as soon as it is constructed.
-  std::unique_ptr<actionlib::SimpleActionServer<PlacePlanAction>> server_;
+  // Goal queue. Never held while calling into actionlib (whose callbacks take it).
+  std::mutex goal_mutex_;
+  std::condition_variable goal_cv_;
+  std::optional<GoalHandle> pending_;  // newest goal, not started yet
+  std::optional<GoalHandle> running_;  // the goal the thread works on
+  bool stopping_ = false;
+  // Cancel or a newer goal: the running goal's planner stops at its next step.
+  std::atomic<bool> preempt_requested_{false};
+  ros::WallTime preempt_time_;  // when it was requested (goal_mutex_)
+  void requestPreempt();        // with goal_mutex_ held
+
+  std::unique_ptr<Server> server_;
+  std::thread goal_thread_;
 };
 
 }  // namespace place_planner

@@ -16,32 +16,12 @@ namespace place_planner {
 namespace fuzz {
 namespace {
 
-// Reads values off the front of the input; past its end every value is 0 (so any length works).
-class Bytes {
- public:
-  Bytes(const uint8_t* data, size_t size) : data_(data), size_(size) {}
-  uint8_t byte() { return pos_ < size_ ? data_[pos_++] : 0; }
-  uint16_t u16() { return static_cast<uint16_t>(byte() | byte() << 8); }
-  // In [lo, hi], 256 steps.
-  double range(double lo, double hi) { return lo + (hi - lo) * byte() / 255.0; }
-  int intIn(int lo, int hi) { return lo + static_cast<int>(u16() % static_cast<unsigned>(hi - lo + 1)); }
-  bool flag() { return byte() & 1; }
-  std::string rest() {
-    const std::string s(reinterpret_cast<const char*>(data_) + pos_, size_ - pos_);
-    pos_ = size_;
-    return s;
-  }
-
- private:
-  const uint8_t* data_;
-  size_t size_, pos_ = 0;
-};
-
-[[noreturn]] void violated(const std::string& what) { throw Violation(what); }
-
 bool unit(const Eigen::Vector3d& n) { return n.allFinite() && std::abs(n.norm() - 1.0) < 1e-6; }
 
-// What mesh.h promises of a built mesh.
+}  // namespace
+
+void violated(const std::string& what) { throw Violation(what); }
+
 void checkMesh(const Mesh& m) {
   const int nv = static_cast<int>(m.vertices.size());
   if (m.empty() || nv == 0) violated("buildMesh returned an empty mesh");
@@ -68,6 +48,8 @@ void checkMesh(const Mesh& m) {
   if (!p.center_of_mass.allFinite() || !p.principal_axes.allFinite() || !std::isfinite(p.bounding_radius))
     violated("mesh properties not finite");
 }
+
+namespace {
 
 // Known bug, found here (mesh.cpp, FuzzFindings.DISABLED_HugeCoordinatesAreRefusedOrFinite):
 // buildMesh accepts coordinates from about 1e77 on, where squared lengths overflow, and returns
@@ -305,6 +287,9 @@ Target targetByName(const std::string& name) {
   if (name == "obj") return obj;
   if (name == "stl") return stl;
   if (name == "planner") return planner;
+#ifdef PP_FUZZ_WITH_ROS
+  if (name == "polygon_mesh") return polygonMesh;
+#endif
   return nullptr;
 }
 

@@ -64,12 +64,13 @@ def ply_binary_structured(big, coord_type, count_type, index_type, with_conf=Fal
 
 
 def obj(quads=False, negative=False, slashes=False):
-    lines = ["# seed", "o tetra"] + ["v %g %g %g" % p for p in TETRA_V]
+    verts = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)] if quads else TETRA_V
+    lines = ["# seed"] + ["v %g %g %g" % p for p in verts]
     if slashes:
         lines += ["vt 0 0", "vn 0 0 1"]
     for f in ([(0, 1, 2, 3)] if quads else TETRA_F):
         if negative:
-            idx = [str(i - len(TETRA_V)) for i in f]
+            idx = [str(i - len(verts)) for i in f]
         else:
             idx = [str(i + 1) for i in f]
         if slashes:
@@ -110,6 +111,26 @@ def planner_seeds():
     return seeds
 
 
+def polygon_mesh(point_step=12, double=False, extra_field=False):
+    # As fuzz_conversions.cpp reads it: height, width (u16), point_step, row-step choice, big
+    # endian choice, fields (name, offset choice, offset, datatype), polygons, data length, data.
+    size = 8 if double else 4
+    datatype = 8 if double else 7  # PointField FLOAT64 / FLOAT32
+    out = bytes([1]) + struct.pack("<H", len(TETRA_V)) + bytes([point_step, 1, 0, 1])
+    fields = [(0, 0), (1, size), (2, 2 * size)] + ([(3, 3 * size)] if extra_field else [])
+    out += bytes([len(fields)])
+    for name, offset in fields:
+        out += bytes([name, 1, offset, datatype])
+    out += bytes([len(TETRA_F)])
+    for f in TETRA_F:
+        out += bytes([3]) + b"".join(bytes([1, i]) for i in f)
+    data = b""
+    for p in TETRA_V:
+        point = struct.pack("<3d" if double else "<3f", *p)
+        data += point.ljust(point_step, b"\0")
+    return out + struct.pack("<H", len(data)) + data
+
+
 def main():
     write("ply_text", "tetra_ascii.ply", ply_ascii())
     write("ply_text", "quad_extra_prop_crlf.ply", ply_ascii(extra_prop=True, crlf=True, quad=True))
@@ -124,6 +145,9 @@ def main():
     write("stl", "tetra_ascii.stl", stl_ascii())
     write("stl", "tetra_binary.stl", stl_binary())
     write("stl", "tetra_binary_solid_header.stl", stl_binary(b"solid but binary"))
+    write("polygon_mesh", "tetra_float32", polygon_mesh())
+    write("polygon_mesh", "tetra_float64_padded", polygon_mesh(point_step=32, double=True, extra_field=True))
+    write("polygon_mesh", "tetra_float32_rgb", polygon_mesh(point_step=16, extra_field=True))
     for name, data in planner_seeds().items():
         write("planner", name, data)
 

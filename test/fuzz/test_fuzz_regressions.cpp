@@ -66,7 +66,12 @@ TEST_P(FuzzReplay, Seeds) { replay(GetParam(), "corpus", 3); }
 TEST_P(FuzzReplay, Regressions) { replay(GetParam(), "regressions", 0); }
 
 INSTANTIATE_TEST_SUITE_P(Targets, FuzzReplay,
-                         testing::Values("ply_text", "ply_binary", "obj", "stl", "planner"));
+                         testing::Values("ply_text", "ply_binary", "obj", "stl", "planner"
+#ifdef PP_FUZZ_WITH_ROS
+                                         , "polygon_mesh"
+#endif
+                                         ),
+                         [](const testing::TestParamInfo<std::string>& i) { return i.param; });
 
 // The reader seeds are a tetrahedron (or a unit quad): they must load, or the fuzzer starts
 // from nothing but errors.

@@ -3,6 +3,8 @@
 // and scripts/fuzz (fuzz_polygon_mesh, against the devel space's generated headers).
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <vector>
 
 #include "fuzz_targets.h"
@@ -55,6 +57,14 @@ void polygonMesh(const uint8_t* data, size_t size) {
     if (polygons[i].size() != msg.polygons[i].vertices.size()) violated("polygon lengths kept");
     for (size_t j = 0; j < polygons[i].size(); ++j) {
       if (polygons[i][j] < 0) violated("an index above INT_MAX must be clamped, not wrapped");
+    }
+  }
+  if (std::getenv("PP_FUZZ_VERBOSE")) {  // what the input became
+    for (const auto& v : vertices) std::fprintf(stderr, "v %.17g %.17g %.17g\n", v.x(), v.y(), v.z());
+    for (const auto& p : polygons) {
+      std::fprintf(stderr, "f");
+      for (int i : p) std::fprintf(stderr, " %d", i);
+      std::fprintf(stderr, "\n");
     }
   }
   Mesh mesh;

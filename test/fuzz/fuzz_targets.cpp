@@ -1,6 +1,7 @@
 #include "fuzz_targets.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,7 +23,15 @@ bool unit(const Eigen::Vector3d& n) { return n.allFinite() && std::abs(n.norm() 
 
 void violated(const std::string& what) { throw Violation(what); }
 
+// Known bug, found here (mesh.cpp, FuzzFindings.DISABLED_HugeCoordinatesAreRefusedOrFinite):
+// buildMesh accepts coordinates from about 1e77 on, where squared lengths overflow, and returns
+// zero or NaN normals, an infinite area and a NaN centre of mass. Until it is fixed such meshes
+// are not checked (all targets), so that fuzzing goes on to other bugs; 1e75 leaves a margin.
+constexpr double kKnownOverflowCoordinate = 1e75;
+
 void checkMesh(const Mesh& m) {
+  for (const auto& v : m.vertices)
+    if (skipKnownBugs() && v.cwiseAbs().maxCoeff() > kKnownOverflowCoordinate) return;
   const int nv = static_cast<int>(m.vertices.size());
   if (m.empty() || nv == 0) violated("buildMesh returned an empty mesh");
   for (const auto& v : m.vertices)
@@ -44,18 +53,21 @@ void checkMesh(const Mesh& m) {
   for (const auto& e : m.edges)
     if (e[0] < 0 || e[0] >= e[1] || e[1] >= nv) violated("edge not (i < j) within the vertices");
   const MeshProperties& p = m.properties;
-  if (!(std::isfinite(p.surface_area) && p.surface_area > 0)) violated("surface area not finite and positive");
+  // Known bug, found here (mesh.cpp, FuzzFindings.DISABLED_DegenerateFarFromOriginIsRefused):
+  // Newell's area vector from absolute coordinates carries rounding of about |p| * size * eps,
+  // which passes the zero-area test (1e-12 of the size squared) once the mesh lies more than some
+  // 1e3 of its sizes from the origin: degenerate polygons are kept, the area can be 0.
+  const double size = (p.bounds_max - p.bounds_min).norm();
+  double far = 0;
+  for (const auto& v : m.vertices) far = std::max(far, v.cwiseAbs().maxCoeff());
+  const bool known_far = skipKnownBugs() && far > 1e3 * size;
+  if (!(std::isfinite(p.surface_area) && (p.surface_area > 0 || known_far)))
+    violated("surface area not finite and positive");
   if (!p.center_of_mass.allFinite() || !p.principal_axes.allFinite() || !std::isfinite(p.bounding_radius))
     violated("mesh properties not finite");
 }
 
 namespace {
-
-// Known bug, found here (mesh.cpp, FuzzFindings.DISABLED_HugeCoordinatesAreRefusedOrFinite):
-// buildMesh accepts coordinates from about 1e77 on, where squared lengths overflow, and returns
-// zero or NaN normals, an infinite area and a NaN centre of mass. Until it is fixed such meshes
-// are not checked, so that fuzzing goes on to other bugs; 1e75 leaves a margin.
-constexpr double kKnownOverflowCoordinate = 1e75;
 
 void parseAndCheck(const std::string& bytes, MeshFormat format) {
   Mesh m;
@@ -64,8 +76,6 @@ void parseAndCheck(const std::string& bytes, MeshFormat format) {
   } catch (const MeshError&) {
     return;  // refused, as documented
   }
-  for (const auto& v : m.vertices)
-    if (skipKnownBugs() && v.cwiseAbs().maxCoeff() > kKnownOverflowCoordinate) return;
   checkMesh(m);
 }
 

@@ -207,7 +207,7 @@ TEST(MeshIoHardening, LoadMeshReadsTheSameAsParseMesh) {
 // owner fixes them (then drop the prefix and the workaround named in fuzz_targets.cpp).
 
 // mesh.cpp buildMesh accepts vertices from about 1e77 on (the fuzzers' first finding, in all
-// three formats: e.g. "v 0 0 1e308" in an OBJ): squared lengths overflow, so the patch normals
+// three formats, and in a float64 PolygonMesh: e.g. "v 0 0 1e308" in an OBJ): squared lengths overflow, so the patch normals
 // come out zero or NaN, the surface area infinite and the centre of mass NaN, and the planner
 // is handed NaN. Expected: a MeshError naming the vertex (as for NaN/Inf coordinates), or
 // finite properties. fuzz_targets.cpp skips such meshes (kKnownOverflowCoordinate) until fixed;
@@ -227,11 +227,31 @@ TEST(FuzzFindings, DISABLED_HugeCoordinatesAreRefusedOrFinite) {
   }
 }
 
+// mesh.cpp buildMesh keeps degenerate polygons of a mesh far from the origin for its size (the
+// PolygonMesh target's finding: four points about 2.8e18 from the origin, three of them
+// identical, the fourth 1.7e12 away): Newell's area vector, summed from absolute coordinates,
+// carries rounding of about |p| * size * eps, above the zero-area tolerance (1e-12 of the size
+// squared), so the four degenerate triangles are kept and the mesh has surface area 0 with
+// arbitrary normals. Expected: a MeshError (nothing but degenerate polygons), as at the origin.
+// Summing relative to the polygon's first vertex would fix it.
+TEST(FuzzFindings, DISABLED_DegenerateFarFromOriginIsRefused) {
+  const double o = -2.8483943054992686e+18;
+  const std::vector<Eigen::Vector3d> v = {{-2.8483943054736097e+18, o, o}, {-2.8483926325171011e+18, o, o},
+                                          {o, o, o}, {o, o, o}};
+  EXPECT_THROW(buildMesh(v, {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}), MeshError);
+}
+
 // The original inputs of the findings above (libFuzzer's crash files, regressions/known/<target>/)
 // through the targets without their workarounds.
 TEST(FuzzFindings, DISABLED_KnownFindingsReplay) {
   fuzz::skipKnownBugs() = false;
-  for (const std::string target : {"ply_text", "ply_binary", "obj", "stl", "planner"}) replay(target, "regressions/known", 0);
+  for (const std::string target : {"ply_text", "ply_binary", "obj", "stl", "planner"
+#ifdef PP_FUZZ_WITH_ROS
+                                    , "polygon_mesh"
+#endif
+       }) {
+    replay(target, "regressions/known", 0);
+  }
   fuzz::skipKnownBugs() = true;
 }
 

@@ -1,7 +1,6 @@
 // place_planner_cli: plan placements of an object mesh on an area mesh from the shell.
 // Arguments by CLI11, the JSON answer by nlohmann::json, written atomically (a temporary file in
 // the destination's directory, then rename), so a reader never sees half a file.
-#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -13,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>

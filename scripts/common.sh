@@ -21,6 +21,8 @@ PP_PACKAGES=(
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libgtest-dev googletest rviz librviz-dev xvfb xauth imagemagick
   libbullet-dev libbullet-extras-dev libtbb-dev libbenchmark-dev
+  libcli11-dev nlohmann-json3-dev
+  clang libclang-rt-dev llvm
 )
 
 pp_install_deps() {

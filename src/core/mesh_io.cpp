@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
+#include <climits>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <tuple>
@@ -17,14 +21,36 @@ std::string lower(std::string s) {
   return s;
 }
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw MeshError(path + ": " + what);
+[[noreturn]] void fail(const std::string& name, const std::string& what) {
+  throw MeshError(name + ": " + what);
+}
+
+// Longer polygons are not a mesh a scanner writes; the cap also bounds the work per list.
+constexpr double kMaxListLength = 1e6;
+
+// A whole number that fits an int (a list length, a vertex index), else false. Read values
+// arrive as doubles; casting one out of range to int is undefined, so it is checked first.
+bool toInt(double v, int* out) {
+  if (!(v >= INT_MIN && v <= INT_MAX) || v != std::floor(v)) return false;
+  *out = static_cast<int>(v);
+  return true;
+}
+
+// Reads the next line (without "\n" or "\r\n") at `pos`; false at the end of `bytes`.
+bool nextLine(const std::string& bytes, size_t* pos, std::string* line) {
+  if (*pos >= bytes.size()) return false;
+  size_t end = bytes.find('\n', *pos);
+  if (end == std::string::npos) end = bytes.size();
+  line->assign(bytes, *pos, end - *pos);
+  *pos = std::min(end + 1, bytes.size());
+  if (!line->empty() && line->back() == '\r') line->pop_back();
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------- PLY
 enum class PlyType { I8, U8, I16, U16, I32, U32, F32, F64 };
 
-PlyType plyType(const std::string& t, const std::string& path) {
+PlyType plyType(const std::string& t, const std::string& name) {
   static const std::map<std::string, PlyType> m = {
       {"char", PlyType::I8},    {"int8", PlyType::I8},     {"uchar", PlyType::U8},
       {"uint8", PlyType::U8},   {"short", PlyType::I16},   {"int16", PlyType::I16},
@@ -33,11 +59,11 @@ PlyType plyType(const std::string& t, const std::string& path) {
       {"float", PlyType::F32},  {"float32", PlyType::F32}, {"double", PlyType::F64},
       {"float64", PlyType::F64}};
   auto it = m.find(t);
-  if (it == m.end()) fail(path, "unknown PLY property type '" + t + "'");
+  if (it == m.end()) fail(name, "unknown PLY property type '" + t + "'");
   return it->second;
 }
 
-int plySize(PlyType t) {
+size_t plySize(PlyType t) {
   switch (t) {
     case PlyType::I8: case PlyType::U8: return 1;
     case PlyType::I16: case PlyType::U16: return 2;
@@ -55,16 +81,25 @@ struct PlyElement {
   std::string name;
   size_t count = 0;
   std::vector<PlyProperty> props;
+  // Bytes one element takes at least: binary (each scalar, each list's length) and ASCII (a
+  // character and a separator per value). Bounds what a header's count may reserve.
+  size_t minBytes(bool ascii) const {
+    size_t n = 0;
+    for (const auto& p : props) n += ascii ? 2 : plySize(p.is_list ? p.count_type : p.type);
+    return n;
+  }
 };
 
 class BinReader {
  public:
-  BinReader(std::istream& in, bool big_endian, const std::string& path)
-      : in_(in), swap_(big_endian), path_(path) {}
+  BinReader(const std::string& bytes, size_t* pos, bool big_endian, const std::string& name)
+      : bytes_(bytes), pos_(pos), swap_(big_endian), name_(name) {}
   double read(PlyType t) {
     unsigned char b[8];
-    const int n = plySize(t);
-    if (!in_.read(reinterpret_cast<char*>(b), n)) fail(path_, "unexpected end of binary PLY data");
+    const size_t n = plySize(t);
+    if (bytes_.size() - *pos_ < n) fail(name_, "unexpected end of binary PLY data");
+    std::memcpy(b, bytes_.data() + *pos_, n);
+    *pos_ += n;
     if (swap_) std::reverse(b, b + n);
     switch (t) {
       case PlyType::I8: { int8_t v; std::memcpy(&v, b, 1); return v; }
@@ -79,21 +114,20 @@ class BinReader {
   }
 
  private:
-  std::istream& in_;
+  const std::string& bytes_;
+  size_t* pos_;
   bool swap_;
-  const std::string& path_;
+  const std::string& name_;
 };
 
-Mesh loadPly(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open file");
+Mesh parsePly(const std::string& bytes, const std::string& name) {
+  size_t pos = 0;
   std::string line;
-  std::getline(in, line);
-  if (line.rfind("ply", 0) != 0) fail(path, "not a PLY file (missing 'ply' magic)");
+  if (!nextLine(bytes, &pos, &line) || line.rfind("ply", 0) != 0) fail(name, "not a PLY file (missing 'ply' magic)");
   std::string format;
   std::vector<PlyElement> elements;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+  bool header_ended = false;
+  while (!header_ended && nextLine(bytes, &pos, &line)) {
     std::istringstream ls(line);
     std::string kw;
     ls >> kw;
@@ -101,10 +135,16 @@ Mesh loadPly(const std::string& path) {
       ls >> format;
     } else if (kw == "element") {
       PlyElement e;
-      ls >> e.name >> e.count;
+      std::string count;
+      ls >> e.name >> count;
+      unsigned long long n = 0;
+      const auto r = std::from_chars(count.data(), count.data() + count.size(), n);
+      if (count.empty() || r.ec != std::errc() || r.ptr != count.data() + count.size())
+        fail(name, "PLY element '" + e.name + "' has a bad count '" + count + "'");
+      e.count = static_cast<size_t>(n);
       elements.push_back(e);
     } else if (kw == "property") {
-      if (elements.empty()) fail(path, "PLY property before any element");
+      if (elements.empty()) fail(name, "PLY property before any element");
       PlyProperty p;
       std::string t;
       ls >> t;
@@ -112,21 +152,22 @@ Mesh loadPly(const std::string& path) {
         std::string ct, it;
         ls >> ct >> it >> p.name;
         p.is_list = true;
-        p.count_type = plyType(ct, path);
-        p.type = plyType(it, path);
+        p.count_type = plyType(ct, name);
+        p.type = plyType(it, name);
       } else {
-        p.type = plyType(t, path);
+        p.type = plyType(t, name);
         ls >> p.name;
       }
       elements.back().props.push_back(p);
     } else if (kw == "end_header") {
-      break;
+      header_ended = true;
     }
   }
+  if (!header_ended) fail(name, "PLY header has no end_header");
   if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
-    fail(path, "unsupported PLY format '" + format + "'");
+    fail(name, "unsupported PLY format '" + format + "'");
   const bool ascii = format == "ascii";
-  BinReader bin(in, format == "binary_big_endian", path);
+  BinReader bin(bytes, &pos, format == "binary_big_endian", name);
 
   std::vector<Eigen::Vector3d> verts;
   std::vector<std::vector<int>> faces;
@@ -141,31 +182,43 @@ Mesh loadPly(const std::string& path) {
     }
     const bool is_vertex = e.name == "vertex";
     const bool is_face = e.name == "face";
-    if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) fail(path, "PLY vertex element lacks x, y or z");
-    if (is_vertex) verts.reserve(e.count);
-    if (is_face) faces.reserve(e.count);
+    if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) fail(name, "PLY vertex element lacks x, y or z");
+    // A binary element without properties takes no bytes: nothing to read, whatever its count
+    // (looping over a count of 10^18 would never end).
+    if (!ascii && e.props.empty()) continue;
+    // Reserve no more than the bytes left can hold: a header may claim any count.
+    const size_t fits = (bytes.size() - pos) / std::max<size_t>(1, e.minBytes(ascii));
+    if (is_vertex) verts.reserve(verts.size() + std::min(e.count, fits));
+    if (is_face) faces.reserve(faces.size() + std::min(e.count, fits));
+    std::istringstream ls;
     for (size_t i = 0; i < e.count; ++i) {
       Eigen::Vector3d p = Eigen::Vector3d::Zero();
       std::vector<int> poly;
-      std::istringstream ls;
       if (ascii) {
-        if (!std::getline(in, line)) fail(path, "unexpected end of ASCII PLY data in element '" + e.name + "'");
+        if (!nextLine(bytes, &pos, &line))
+          fail(name, "unexpected end of ASCII PLY data in element '" + e.name + "'");
+        ls.clear();
         ls.str(line);
       }
       auto next = [&](PlyType t) -> double {
         if (!ascii) return bin.read(t);
         double v;
-        if (!(ls >> v)) fail(path, "malformed ASCII PLY line in element '" + e.name + "' " + std::to_string(i));
+        if (!(ls >> v)) fail(name, "malformed ASCII PLY line in element '" + e.name + "' " + std::to_string(i));
         return v;
       };
       for (size_t k = 0; k < e.props.size(); ++k) {
         const auto& pr = e.props[k];
         if (pr.is_list) {
-          const double cnt = next(pr.count_type);
-          if (cnt < 0 || cnt > 1e6) fail(path, "bad list length in element '" + e.name + "' " + std::to_string(i));
-          for (int j = 0; j < static_cast<int>(cnt); ++j) {
+          int cnt = 0;
+          if (!toInt(next(pr.count_type), &cnt) || cnt < 0 || cnt > kMaxListLength)
+            fail(name, "bad list length in element '" + e.name + "' " + std::to_string(i));
+          for (int j = 0; j < cnt; ++j) {
             const double v = next(pr.type);
-            if (static_cast<int>(k) == iface) poly.push_back(static_cast<int>(v));
+            if (static_cast<int>(k) != iface) continue;
+            int idx = 0;
+            if (!toInt(v, &idx))
+              fail(name, "face " + std::to_string(i) + " has a vertex index that is not an int");
+            poly.push_back(idx);
           }
         } else {
           const double v = next(pr.type);
@@ -178,52 +231,51 @@ Mesh loadPly(const std::string& path) {
       if (is_face) faces.push_back(std::move(poly));
     }
   }
-  return buildMesh(verts, faces, path);
+  return buildMesh(verts, faces, name);
 }
 
 // ---------------------------------------------------------------------------------------- OBJ
-Mesh loadObj(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) fail(path, "cannot open file");
+Mesh parseObj(const std::string& bytes, const std::string& name) {
   std::vector<Eigen::Vector3d> verts;
   std::vector<std::vector<int>> faces;
   std::string line;
-  size_t lineno = 0;
-  while (std::getline(in, line)) {
+  size_t pos = 0, lineno = 0;
+  while (nextLine(bytes, &pos, &line)) {
     ++lineno;
     std::istringstream ls(line);
     std::string kw;
     ls >> kw;
     if (kw == "v") {
       Eigen::Vector3d p;
-      if (!(ls >> p.x() >> p.y() >> p.z())) fail(path, "line " + std::to_string(lineno) + ": malformed vertex");
+      if (!(ls >> p.x() >> p.y() >> p.z())) fail(name, "line " + std::to_string(lineno) + ": malformed vertex");
       verts.push_back(p);
     } else if (kw == "f") {
       std::vector<int> poly;
       std::string tok;
       while (ls >> tok) {
-        const int idx = std::stoi(tok.substr(0, tok.find('/')));
-        // 1-based; negative indices count back from the last vertex read.
+        // "v", "v/vt", "v//vn" or "v/vt/vn": the position index is the first number.
+        const size_t end = std::min(tok.find('/'), tok.size());
+        int idx = 0;
+        const auto r = std::from_chars(tok.data(), tok.data() + end, idx);
+        if (r.ec != std::errc() || r.ptr != tok.data() + end || idx == 0)
+          fail(name, "line " + std::to_string(lineno) + ": bad vertex index '" + tok + "'");
+        // 1-based; negative indices count back from the last vertex read (-1: the last).
         poly.push_back(idx > 0 ? idx - 1 : static_cast<int>(verts.size()) + idx);
       }
       faces.push_back(std::move(poly));
     }
   }
-  return buildMesh(verts, faces, path);
+  return buildMesh(verts, faces, name);
 }
 
 // ---------------------------------------------------------------------------------------- STL
-Mesh loadStl(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) fail(path, "cannot open file");
-  const auto size = static_cast<size_t>(in.tellg());
-  in.seekg(0);
-  std::vector<char> data(size);
-  in.read(data.data(), static_cast<std::streamsize>(size));
+Mesh parseStl(const std::string& data, const std::string& name) {
+  const size_t size = data.size();
   std::vector<Eigen::Vector3d> corners;
   uint32_t n = 0;
   if (size >= 84) std::memcpy(&n, data.data() + 80, 4);
   if (size >= 84 && size == 84 + 50ull * n) {
+    corners.reserve(3ull * n);
     for (uint32_t i = 0; i < n; ++i) {
       const char* f = data.data() + 84 + 50ull * i + 12;
       for (int k = 0; k < 3; ++k) {
@@ -233,21 +285,28 @@ Mesh loadStl(const std::string& path) {
       }
     }
   } else {
-    std::istringstream ls(std::string(data.begin(), data.end()));
+    std::istringstream ls(data);
     std::string tok;
     while (ls >> tok) {
       if (tok == "vertex") {
         Eigen::Vector3d p;
-        if (!(ls >> p.x() >> p.y() >> p.z())) fail(path, "malformed ASCII STL vertex");
+        if (!(ls >> p.x() >> p.y() >> p.z())) fail(name, "malformed ASCII STL vertex");
         corners.push_back(p);
       }
     }
-    if (corners.size() % 3 != 0) fail(path, "ASCII STL facet without 3 vertices");
+    if (corners.size() % 3 != 0) fail(name, "ASCII STL facet without 3 vertices");
+  }
+  // The merge below orders coordinates: a NaN would break the map's ordering, so refuse it here
+  // (buildMesh would refuse it later anyway).
+  for (size_t i = 0; i < corners.size(); ++i) {
+    if (!corners[i].allFinite())
+      fail(name, "facet " + std::to_string(i / 3) + " has a non-finite coordinate");
   }
   // STL repeats vertices per facet: merge identical coordinates so edges are shared.
   std::map<std::tuple<double, double, double>, int> ids;
   std::vector<Eigen::Vector3d> verts;
   std::vector<std::vector<int>> faces;
+  faces.reserve(corners.size() / 3);
   for (size_t i = 0; i < corners.size(); i += 3) {
     std::vector<int> poly;
     for (size_t k = 0; k < 3; ++k) {
@@ -258,27 +317,53 @@ Mesh loadStl(const std::string& path) {
     }
     faces.push_back(poly);
   }
-  return buildMesh(verts, faces, path);
+  return buildMesh(verts, faces, name);
 }
 
 }  // namespace
 
+Mesh parseMesh(const std::string& bytes, MeshFormat format, const std::string& name) {
+  switch (format) {
+    case MeshFormat::kPly: return parsePly(bytes, name);
+    case MeshFormat::kObj: return parseObj(bytes, name);
+    case MeshFormat::kStl: return parseStl(bytes, name);
+  }
+  fail(name, "unknown mesh format");
+}
+
 Mesh loadMesh(const std::string& path) {
   const auto dot = path.find_last_of('.');
   const std::string ext = dot == std::string::npos ? "" : lower(path.substr(dot + 1));
-  if (ext == "ply") return loadPly(path);
-  if (ext == "obj") return loadObj(path);
-  if (ext == "stl") return loadStl(path);
-  fail(path, "unsupported mesh format '" + ext + "' (use .ply, .obj or .stl)");
+  MeshFormat format;
+  if (ext == "ply") {
+    format = MeshFormat::kPly;
+  } else if (ext == "obj") {
+    format = MeshFormat::kObj;
+  } else if (ext == "stl") {
+    format = MeshFormat::kStl;
+  } else {
+    fail(path, "unsupported mesh format '" + ext + "' (use .ply, .obj or .stl)");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (in.bad()) fail(path, "read error");
+  return parseMesh(bytes.str(), format, path);
 }
 
 void saveMeshPly(const Mesh& mesh, const std::string& path, bool binary) {
   std::ofstream out(path, std::ios::binary);
   if (!out) fail(path, "cannot write file");
+  out.precision(std::numeric_limits<double>::max_digits10);  // ASCII: the doubles exactly
+  // A list length of a byte holds 255: longer patches (a cylinder's cap of 256 sides) need more.
+  size_t longest = 0;
+  for (const auto& p : mesh.patches) longest = std::max(longest, p.size());
+  const bool wide = longest > 255;
   out << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
       << "element vertex " << mesh.vertices.size() << "\nproperty float x\nproperty float y\n"
-      << "property float z\nelement face " << mesh.patches.size()
-      << "\nproperty list uchar int vertex_indices\nend_header\n";
+      << "property float z\nelement face " << mesh.patches.size() << "\nproperty list "
+      << (wide ? "uint" : "uchar") << " int vertex_indices\nend_header\n";
   for (const auto& v : mesh.vertices) {
     if (binary) {
       const float f[3] = {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
@@ -289,8 +374,13 @@ void saveMeshPly(const Mesh& mesh, const std::string& path, bool binary) {
   }
   for (const auto& p : mesh.patches) {
     if (binary) {
-      const unsigned char c = static_cast<unsigned char>(p.size());
-      out.write(reinterpret_cast<const char*>(&c), 1);
+      if (wide) {
+        const uint32_t c = static_cast<uint32_t>(p.size());
+        out.write(reinterpret_cast<const char*>(&c), 4);
+      } else {
+        const unsigned char c = static_cast<unsigned char>(p.size());
+        out.write(reinterpret_cast<const char*>(&c), 1);
+      }
       for (int i : p) {
         const int32_t v = i;
         out.write(reinterpret_cast<const char*>(&v), 4);
@@ -301,6 +391,8 @@ void saveMeshPly(const Mesh& mesh, const std::string& path, bool binary) {
       out << '\n';
     }
   }
+  out.close();
+  if (!out) fail(path, "write failed");
 }
 
 }  // namespace place_planner

@@ -1,14 +1,24 @@
 // place_planner_cli: plan placements of an object mesh on an area mesh from the shell.
+// Arguments by CLI11, the JSON answer by nlohmann::json, written atomically (a temporary file in
+// the destination's directory, then rename), so a reader never sees half a file.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <iostream>
+#include <cstring>
 #include <map>
-#include <sstream>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "place_planner/area_up.h"
+#include "place_planner/cuda_backend.h"
 #include "place_planner/mesh_io.h"
 #include "place_planner/planner.h"
 #include "place_planner/scenes.h"
@@ -17,76 +27,221 @@
 #endif
 
 using namespace place_planner;
+using Json = nlohmann::ordered_json;  // keys in the order written, as a reader expects them
 
 namespace {
 
-const char* kUsage =
-    "usage: place_planner_cli --object O.ply --area P.ply [--gravity x,y,z|auto] [--approach x,y,z]\n"
-    "       [--friction F] [--spacing M] [--max-rotations N] [--orientation MODE]\n"
-    "       [--max-resting-faces N] [--robust-shift M] [--robust-tilt-deg D]\n"
-    "       [--robust-com-offset F] [--robust-min-share S] [--no-robust-check]\n"
-    "       [--budget-ms T] [--max-candidates K] [--threads N] [--backend auto|cpu|cuda]\n"
-    "       [--verify K] [--json OUT]\n"
-    "  O and P are .ply/.obj/.stl files or builtin:NAME (table, dish_rack, open_box,\n"
-    "  binder_stack, mug, plate, pen, cube). MODE: auto | principal_axis | keep | all_axes.\n"
-    "  --gravity auto: against the normal of the area's largest flat region (a scan in its\n"
-    "  camera frame).\n"
-    "  --verify K: simulate the best K stable candidates in Bullet (released 2 mm above the pose;\n"
-    "  stayed = moved < 1 cm, turned < 5 deg) within what is left of --budget-ms; one that falls\n"
-    "  is moved behind the other stable candidates. 0 (default) = off.\n"
-    "  Exit: 0 stable candidates found (also a partial answer when the budget ran out),\n"
-    "  1 no stable pose (search complete), 3 budget ran out with nothing stable, 2 bad input.\n"
-    "  The last line of stdout is always 'outcome: ...'.\n";
+// Exit codes (README "Command line"; also in --help).
+constexpr int kExitStable = 0;       // stable candidates (search complete, or a partial answer)
+constexpr int kExitNoStable = 1;     // search complete, nothing stable
+constexpr int kExitBadInput = 2;     // bad option, value out of range, unreadable mesh, unwritable --json
+constexpr int kExitTimedOut = 3;     // budget ran out before anything stable
+constexpr int kExitOutputError = 4;  // planned, but writing --json failed (disk full, I/O error)
 
-Eigen::Vector3d parseVec(const std::string& flag, const std::string& s) {
+const char* kFooter =
+    "Meshes: .ply (ASCII or binary), .obj, .stl, or builtin:NAME (table, dish_rack, open_box,\n"
+    "binder_stack, mug, plate, pen, cube).\n"
+    "--gravity auto: against the normal of the area's largest flat region (a scan in its camera\n"
+    "frame). --backend gpu is the same as cuda: an error (exit 2) when no CUDA device is usable;\n"
+    "auto falls back to the CPU.\n"
+    "--verify K: simulate the best K stable candidates in Bullet (released 2 mm above the pose;\n"
+    "stayed = moved < 1 cm, turned < 5 deg) within what is left of --budget-ms; one that falls is\n"
+    "moved behind the other stable candidates.\n"
+    "--json OUT is replaced atomically (a temporary file beside it, then rename).\n"
+    "\n"
+    "The last line of stdout is always 'outcome: ...'. Exit codes:\n"
+    "  0  stable candidates found (outcome stable, or timed_out_partial: a partial answer)\n"
+    "  1  the search completed and nothing is stable (no_stable_pose)\n"
+    "  2  bad input: unknown or malformed option, value out of range, unreadable mesh, --json\n"
+    "     not writable, CUDA requested but unavailable (bad_input; one error line on stderr)\n"
+    "  3  the budget ran out before anything stable was found (timed_out)\n"
+    "  4  planned, but the --json file could not be written (output_error)\n";
+
+// An error that is the input's fault (exit 2), or the output's (exit 4).
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Doubles must be finite: CLI11 would accept "nan" and "inf".
+const CLI::Validator kFinite(
+    [](std::string& s) -> std::string {
+      double v = 0;
+      if (!CLI::detail::lexical_cast(s, v)) return "'" + s + "' is not a number";
+      return std::isfinite(v) ? std::string() : "'" + s + "' is not a finite number";
+    },
+    "FINITE");
+
+// "x,y,z", each element converted by CLI11's own number conversion.
+Eigen::Vector3d parseVector(const std::string& flag, const std::string& s) {
+  const std::vector<std::string> parts = CLI::detail::split(s, ',');
   Eigen::Vector3d v;
-  char c1, c2;
-  std::istringstream is(s);
-  if (!(is >> v.x() >> c1 >> v.y() >> c2 >> v.z()) || c1 != ',' || c2 != ',')
-    throw std::invalid_argument(flag + " expects x,y,z (got '" + s + "')");
+  bool ok = parts.size() == 3;
+  for (size_t i = 0; ok && i < 3; ++i) ok = CLI::detail::lexical_cast(parts[i], v[i]) && std::isfinite(v[i]);
+  if (!ok) throw CLI::ValidationError(flag, "expects x,y,z: three finite numbers (got '" + s + "')");
   return v;
 }
 
-double parseNum(const std::string& flag, const std::string& s) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || *end) throw std::invalid_argument(flag + " expects a number (got '" + s + "')");
-  return v;
-}
+// validate() names the config field; the user typed a flag: name both.
+const std::map<std::string, std::string> kFlagOfField = {
+    {"gravity", "--gravity"},
+    {"approach", "--approach"},
+    {"friction", "--friction"},
+    {"floor_point_spacing", "--spacing"},
+    {"max_rotations", "--max-rotations"},
+    {"max_resting_faces", "--max-resting-faces"},
+    {"robust_shift", "--robust-shift"},
+    {"robust_tilt_deg", "--robust-tilt-deg"},
+    {"robust_com_offset", "--robust-com-offset"},
+    {"robust_min_share", "--robust-min-share"},
+    {"time_budget_ms", "--budget-ms"},
+    {"max_candidates", "--max-candidates"},
+    {"threads", "--threads"},
+};
 
-Mesh load(const std::string& spec) {
-  if (spec.rfind("builtin:", 0) == 0) return scenes::byName(spec.substr(8));
-  return loadMesh(spec);
-}
-
-void vecJson(std::ostream& o, const Eigen::Vector3d& v) {
-  o << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
-}
-void quatJson(std::ostream& o, const Eigen::Matrix3d& R) {
-  const Eigen::Quaterniond q(R);
-  o << "[" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w() << "]";
-}
-
-std::string jsonEscaped(const std::string& s) {
-  std::string out;
-  for (char ch : s) {
-    if (ch == '"' || ch == '\\') out += '\\';
-    out += ch;
+void validateNamingFlags(const PlannerConfig& c) {
+  try {
+    validate(c);
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    const auto it = kFlagOfField.find(what.substr(0, what.find(' ')));
+    throw InputError(it == kFlagOfField.end() ? what : it->second + ": " + what);
   }
-  return out;
 }
 
-// Exit codes (README "Using it"): 0 stable (complete or partial), 1 no stable pose, 3 timed out
-// with nothing stable, 2 bad input (main's catch).
+Mesh load(const std::string& flag, const std::string& spec) {
+  try {
+    if (spec.rfind("builtin:", 0) == 0) return scenes::byName(spec.substr(8));
+    return loadMesh(spec);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(flag + ": " + e.what());
+  }
+}
+
+std::string errnoText(const std::string& what, const std::string& path) {
+  return what + " " + path + ": " + std::strerror(errno);
+}
+
+// The file is written whole or not at all: the text goes to a temporary file in the same
+// directory (so that rename is atomic: same file system), is flushed to disk, then renamed
+// over `path`. Concurrent writers each have their own temporary file; the last rename wins.
+class AtomicFile {
+ public:
+  // Checks up front, before any planning, that `path` can be written: its directory accepts a
+  // new file and it is not a directory. Throws InputError.
+  explicit AtomicFile(std::string path) : path_(std::move(path)) {
+    struct stat st;
+    if (stat(path_.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+      throw InputError("--json: " + path_ + " is a directory");
+    const int fd = makeTemp();
+    if (fd < 0) throw InputError("--json: " + errnoText("cannot create a file beside", path_));
+    close(fd);
+    unlink(temp_.c_str());
+  }
+
+  // Throws OutputError; the destination is then as it was, and no temporary file is left.
+  void write(const std::string& text) {
+    const int fd = makeTemp();
+    if (fd < 0) throw OutputError(errnoText("cannot create a file beside", path_));
+    int err = 0;
+    // mkstemp creates 0600; give the file the mode a plain open() would (0666 less the umask).
+    const mode_t mask = umask(0);
+    umask(mask);
+    if (fchmod(fd, 0666 & ~mask) != 0) err = errno;
+    for (size_t done = 0; !err && done < text.size();) {
+      const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        err = n < 0 ? errno : EIO;
+      } else {
+        done += static_cast<size_t>(n);
+      }
+    }
+    if (!err && fsync(fd) != 0) err = errno;
+    if (close(fd) != 0 && !err) err = errno;
+    if (!err && rename(temp_.c_str(), path_.c_str()) != 0) err = errno;
+    if (!err) return;
+    unlink(temp_.c_str());
+    throw OutputError("cannot write " + path_ + ": " + std::strerror(err));
+  }
+
+ private:
+  int makeTemp() {
+    std::vector<char> name(path_.begin(), path_.end());
+    for (char c : std::string(".tmp.XXXXXX")) name.push_back(c);
+    name.push_back('\0');
+    const int fd = mkstemp(name.data());
+    temp_ = name.data();
+    return fd;
+  }
+
+  std::string path_, temp_;
+};
+
+Json vecJson(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+Json quatJson(const Eigen::Matrix3d& R) {
+  const Eigen::Quaterniond q(R);
+  return Json::array({q.x(), q.y(), q.z(), q.w()});
+}
+
+Json resultJson(const std::string& object, const std::string& area, const PlannerConfig& c,
+                const PlanResult& r) {
+  const auto& st = r.stats;
+  Json j;
+  j["object"] = object;
+  j["area"] = area;
+  j["outcome"] = toString(r.outcome());
+  j["stable_candidates"] = r.stableCount();
+  j["planning_ms"] = st.total_ms;
+  j["first_stable_ms"] = st.first_stable_ms;
+  j["floor_points"] = st.floor_points_total;
+  j["floor_points_done"] = st.floor_points_done;
+  j["backend"] = st.backend;
+  j["gravity"] = vecJson(c.gravity);
+  j["warnings"] = r.warnings;
+  Json candidates = Json::array();
+  for (const auto& k : r.candidates) {
+    Json contacts = Json::array();
+    for (const auto& p : k.contacts) contacts.push_back({{"p", vecJson(p.p_W)}, {"n", vecJson(p.n_W)}});
+    Json poses = Json::array();
+    for (const auto& X : k.intermediate_poses)
+      poses.push_back({{"position", vecJson(X.translation())}, {"orientation_xyzw", quatJson(X.linear())}});
+    candidates.push_back({
+        {"position", vecJson(k.X_WO.translation())},
+        {"orientation_xyzw", quatJson(k.X_WO.linear())},
+        {"quality", k.quality},
+        {"stable", k.stable},
+        {"start", toString(k.start)},
+        {"robustness",
+         {{"trials", k.robustness.trials},
+          {"held", k.robustness.held},
+          {"share", k.robustness.share()},
+          {"min_tipping_angle", k.robustness.min_tipping_angle}}},
+        {"physics",
+         {{"checked", k.physics.checked},
+          {"stayed", k.physics.stayed},
+          {"moved_m", k.physics.moved_m},
+          {"turned_deg", k.physics.turned_deg}}},
+        {"floor_point", vecJson(k.floor_point_W)},
+        {"contacts", contacts},
+        {"intermediate_poses", poses},
+    });
+  }
+  j["candidates"] = candidates;
+  return j;
+}
+
 int exitCode(PlanOutcome o) {
   switch (o) {
     case PlanOutcome::kStable:
-    case PlanOutcome::kTimedOutWithStable: return 0;
-    case PlanOutcome::kNoStable: return 1;
+    case PlanOutcome::kTimedOutWithStable: return kExitStable;
+    case PlanOutcome::kNoStable: return kExitNoStable;
     case PlanOutcome::kTimedOutNone:
-    case PlanOutcome::kCancelled: return 3;  // the CLI never cancels
+    case PlanOutcome::kCancelled: return kExitTimedOut;  // the CLI never cancels
   }
-  return 3;
+  return kExitTimedOut;
 }
 
 std::string physicsCell(const PhysicsCheck& p) { return p.checked ? (p.stayed ? "yes" : "no") : "-"; }
@@ -96,78 +251,168 @@ std::string robustnessCell(const Robustness& r) {
   return std::to_string(r.held) + "/" + std::to_string(r.trials);
 }
 
+void printReport(const std::string& object_spec, const Mesh& object, const std::string& area_spec,
+                 const Mesh& area, const PlannerConfig& c, const PlanResult& r) {
+  const auto& st = r.stats;
+  std::printf("object %s (%zu triangles), area %s (%zu triangles), backend %s, orientation %s\n",
+              object_spec.c_str(), object.triangles.size(), area_spec.c_str(), area.triangles.size(),
+              st.backend.c_str(), toString(c.orientation).c_str());
+  std::printf("floor points %d of %d, tree nodes %ld, planning %.1f ms, first stable %.1f ms\n",
+              st.floor_points_done, st.floor_points_total, st.tree_nodes, st.total_ms, st.first_stable_ms);
+  std::printf("steps [ms]: setup %.1f, floor points %.1f, distance %.1f, contacts %.1f, vertex/surface %.1f, "
+              "edge/edge %.1f, stability %.1f, local optimisation %.1f, robustness %.1f\n",
+              st.steps.setup, st.steps.floor_points, st.steps.first_contact, st.steps.contact_points,
+              st.steps.tilt_vertex, st.steps.tilt_edge, st.steps.stability, st.steps.local_optimisation,
+              st.robustness_ms);
+}
+
+void printTable(const PlanResult& r) {
+  std::printf("%4s %7s %6s %6s %7s %-14s %26s %32s %8s\n", "rank", "quality", "stable", "robust",
+              "physics", "start", "position [m]", "orientation xyzw", "contacts");
+  for (size_t i = 0; i < r.candidates.size(); ++i) {
+    const auto& k = r.candidates[i];
+    const Eigen::Quaterniond q(k.X_WO.linear());
+    const Eigen::Vector3d p = k.X_WO.translation();
+    std::printf("%4zu %7.3f %6s %6s %7s %-14s (%7.3f %7.3f %7.3f) (%6.3f %6.3f %6.3f %6.3f) %8zu\n", i + 1,
+                k.quality, k.stable ? "yes" : "no", robustnessCell(k.robustness).c_str(),
+                physicsCell(k.physics).c_str(), toString(k.start), p.x(), p.y(), p.z(), q.x(), q.y(), q.z(),
+                q.w(), k.contacts.size());
+  }
+}
+
+// The answer in one line, always last on stdout (scripts read it with tail -1).
+void printOutcome(const PlannerConfig& c, const PlanResult& r) {
+  const auto& st = r.stats;
+  const int n_stable = r.stableCount();
+  const PlanOutcome outcome = r.outcome();
+  switch (outcome) {
+    case PlanOutcome::kStable:
+      std::printf("outcome: stable (%d stable candidate%s)\n", n_stable, n_stable == 1 ? "" : "s");
+      break;
+    case PlanOutcome::kTimedOutWithStable:
+      std::printf("partial answer: the time budget of %.1f ms ran out after %d of %d floor points\n",
+                  c.time_budget_ms, st.floor_points_done, st.floor_points_total);
+      std::printf("outcome: timed_out_partial (%d stable candidate%s so far)\n", n_stable,
+                  n_stable == 1 ? "" : "s");
+      break;
+    case PlanOutcome::kNoStable:
+      std::printf("outcome: no_stable_pose (%zu candidates, none stable, all %d floor points searched)\n",
+                  r.candidates.size(), st.floor_points_total);
+      break;
+    case PlanOutcome::kTimedOutNone:
+    case PlanOutcome::kCancelled:
+      std::printf("outcome: %s (nothing stable in %d of %d floor points within %.1f ms)\n", toString(outcome),
+                  st.floor_points_done, st.floor_points_total, c.time_budget_ms);
+      break;
+  }
+}
+
+int fail(int code, const std::string& outcome, const std::string& what) {
+  std::fflush(stdout);
+  std::fprintf(stderr, "place_planner_cli: error: %s\n", what.c_str());
+  std::printf("outcome: %s\n", outcome.c_str());
+  return code;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  CLI::App app{"Plans stable placements of an object mesh on a placement area mesh.",
+               "place_planner_cli"};
+  app.footer(kFooter);
+  app.get_formatter()->column_width(34);
+
+  PlannerConfig c;
+  std::string object_spec, area_spec, json_path;
+  bool auto_gravity = false, no_robust_check = false;
+  int verify_k = 0;
+
+  app.add_option("--object", object_spec, "object mesh (its own frame O): file or builtin:NAME")
+      ->required();
+  app.add_option("--area", area_spec, "placement area mesh (the planning frame W)")->required();
+  app.add_option_function<std::string>(
+         "--gravity",
+         [&](const std::string& s) {
+           auto_gravity = s == "auto";
+           if (!auto_gravity) c.gravity = parseVector("--gravity", s);
+         },
+         "gravity direction d_g, or auto (default 0,0,-1)")
+      ->type_name("x,y,z|auto");
+  app.add_option_function<std::string>(
+         "--approach", [&](const std::string& s) { c.approach = parseVector("--approach", s); },
+         "approach direction d_vis (default: along gravity)")
+      ->type_name("x,y,z");
+  app.add_option("--friction", c.friction, "friction coefficient mu")->check(kFinite)->capture_default_str();
+  app.add_option("--spacing", c.floor_point_spacing, "floor point spacing [m]")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--max-rotations", c.max_rotations, "depth of the rotation tree")->capture_default_str();
+  app.add_option_function<std::string>(
+         "--orientation",
+         [&](const std::string& s) {
+           try {
+             c.orientation = orientationModeFromString(s);
+           } catch (const std::invalid_argument& e) {
+             throw CLI::ValidationError("--orientation", e.what());
+           }
+         },
+         "start orientations: auto | principal_axis | keep | all_axes (default auto)")
+      ->type_name("MODE");
+  app.add_option("--max-resting-faces", c.max_resting_faces, "auto: resting faces tried")->capture_default_str();
+  app.add_option("--robust-shift", c.robust_shift, "robustness: release offset [m]")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--robust-tilt-deg", c.robust_tilt_deg, "robustness: release tilt [deg]")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--robust-com-offset", c.robust_com_offset, "robustness: centre of mass offset (share of size)")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--robust-min-share", c.robust_min_share, "robustness: share of releases that must hold")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_flag("--no-robust-check", no_robust_check, "static stability only (the paper)");
+  app.add_option("--budget-ms", c.time_budget_ms, "time budget [ms], 0 = none")->check(kFinite)->capture_default_str();
+  app.add_option("--max-candidates", c.max_candidates, "candidates returned")->capture_default_str();
+  app.add_option("--threads", c.threads, "CPU threads, 0 = all")->capture_default_str();
+  // gpu is cuda by another name, never a silent auto: unavailable CUDA is an error.
+  const std::map<std::string, BackendKind> backends = {
+      {"auto", BackendKind::kAuto}, {"cpu", BackendKind::kCpu}, {"cuda", BackendKind::kCuda}, {"gpu", BackendKind::kCuda}};
+  std::string backend_name = "auto";
+  app.add_option("--backend", backend_name, "auto: CUDA when a GPU is usable, else CPU; gpu = cuda")
+      ->check(CLI::IsMember(backends))
+      ->capture_default_str()
+      ->type_name("NAME");
+  app.add_option("--verify", verify_k, "physics check of the best K stable candidates, 0 = off")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--json", json_path, "write the answer as JSON to this file")->type_name("OUT");
+
   try {
-    // Options that take no value.
-    static const char* flags[] = {"--no-robust-check"};
-    static const char* known[] = {"--object", "--area", "--gravity", "--approach", "--friction",
-                                  "--spacing", "--max-rotations", "--orientation", "--budget-ms",
-                                  "--max-candidates", "--threads", "--json", "--backend",
-                                  "--max-resting-faces", "--robust-shift", "--robust-tilt-deg",
-                                  "--robust-com-offset", "--robust-min-share", "--verify"};
-    std::map<std::string, std::string> args;
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      if (a == "-h" || a == "--help") {
-        std::cout << kUsage;
-        return 0;
-      }
-      bool is_flag = false;
-      for (const char* f : flags) is_flag |= a == f;
-      if (is_flag) {
-        args[a] = "";
-        continue;
-      }
-      bool ok = false;
-      for (const char* k : known) ok |= a == k;
-      if (a.rfind("--", 0) == 0 && !ok) throw std::invalid_argument("unknown option " + a + " (see --help)");
-      if (!ok || i + 1 >= argc)
-        throw std::invalid_argument("unexpected argument '" + a + "' (see --help)");
-      args[a] = argv[++i];
-    }
-    if (!args.count("--object") || !args.count("--area"))
-      throw std::invalid_argument("--object and --area are required (see --help)");
-    const auto integer = [&](const char* flag) {
-      const double v = parseNum(flag, args[flag]);
-      if (v != static_cast<int>(v)) throw std::invalid_argument(std::string(flag) + " expects an integer");
-      return static_cast<int>(v);
-    };
-    PlannerConfig c;
-    const bool auto_gravity = args.count("--gravity") && args["--gravity"] == "auto";
-    if (args.count("--gravity") && !auto_gravity) c.gravity = parseVec("--gravity", args["--gravity"]);
-    if (args.count("--approach")) c.approach = parseVec("--approach", args["--approach"]);
-    if (args.count("--friction")) c.friction = parseNum("--friction", args["--friction"]);
-    if (args.count("--spacing")) c.floor_point_spacing = parseNum("--spacing", args["--spacing"]);
-    if (args.count("--max-rotations")) c.max_rotations = integer("--max-rotations");
-    if (args.count("--orientation")) c.orientation = orientationModeFromString(args["--orientation"]);
-    if (args.count("--max-resting-faces")) c.max_resting_faces = integer("--max-resting-faces");
-    if (args.count("--robust-shift")) c.robust_shift = parseNum("--robust-shift", args["--robust-shift"]);
-    if (args.count("--robust-tilt-deg"))
-      c.robust_tilt_deg = parseNum("--robust-tilt-deg", args["--robust-tilt-deg"]);
-    if (args.count("--robust-com-offset"))
-      c.robust_com_offset = parseNum("--robust-com-offset", args["--robust-com-offset"]);
-    if (args.count("--robust-min-share"))
-      c.robust_min_share = parseNum("--robust-min-share", args["--robust-min-share"]);
-    if (args.count("--no-robust-check")) c.robust_check = false;
-    if (args.count("--budget-ms")) c.time_budget_ms = parseNum("--budget-ms", args["--budget-ms"]);
-    if (args.count("--max-candidates")) c.max_candidates = integer("--max-candidates");
-    if (args.count("--threads")) c.threads = integer("--threads");
-    if (args.count("--backend")) {
-      const std::string b = args["--backend"];
-      if (b != "auto" && b != "cpu" && b != "cuda")
-        throw std::invalid_argument("--backend expects auto, cpu or cuda (got '" + b + "')");
-      c.backend = b == "cpu" ? BackendKind::kCpu : b == "cuda" ? BackendKind::kCuda : BackendKind::kAuto;
-    }
-    const int verify_k = args.count("--verify") ? integer("--verify") : 0;
-    if (verify_k < 0) throw std::invalid_argument("--verify expects K >= 0");
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help
+    return fail(kExitBadInput, "bad_input", std::string(e.what()) + " (see --help)");
+  }
+
+  PlanResult r;
+  try {
+    if (no_robust_check) c.robust_check = false;
 #ifndef PLACE_PLANNER_HAVE_VALIDATION
-    if (verify_k > 0) throw std::invalid_argument("--verify: built without Bullet (no validation library)");
+    if (verify_k > 0) throw InputError("--verify: built without Bullet (no validation library)");
 #endif
-    validate(c);
-    const Mesh object = load(args["--object"]);
-    const Mesh area = load(args["--area"]);
+    validateNamingFlags(c);
+    c.backend = backends.at(backend_name);
+    if (c.backend == BackendKind::kCuda) {
+      std::string why;
+      if (!cuda::available(&why))
+        throw InputError("--backend " + backend_name + ": the CUDA backend is unavailable (" + why + ")");
+    }
+    // Before planning: a typo in the output path should not cost the plan.
+    std::unique_ptr<AtomicFile> json_file;
+    if (!json_path.empty()) json_file = std::make_unique<AtomicFile>(json_path);
+    const Mesh object = load("--object", object_spec);
+    const Mesh area = load("--area", area_spec);
     if (auto_gravity) {
       // Against the normal of the area's largest flat region (area_up.h).
       const UpEstimate e = estimateUp(area, -c.gravity);
@@ -175,121 +420,33 @@ int main(int argc, char** argv) {
       std::printf("gravity (auto): (%.3f, %.3f, %.3f), the largest flat region being %.0f %% of the area\n",
                   c.gravity.x(), c.gravity.y(), c.gravity.z(), 100 * e.share);
     }
-    PlanResult r = Planner().plan(object, area, c);
+    r = Planner().plan(object, area, c);
     for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-    const auto& st = r.stats;
-    std::printf("object %s (%zu triangles), area %s (%zu triangles), backend %s, orientation %s\n",
-                args["--object"].c_str(), object.triangles.size(), args["--area"].c_str(),
-                area.triangles.size(), st.backend.c_str(), toString(c.orientation).c_str());
-    std::printf("floor points %d of %d, tree nodes %ld, planning %.1f ms, first stable %.1f ms\n",
-                st.floor_points_done, st.floor_points_total, st.tree_nodes, st.total_ms,
-                st.first_stable_ms);
-    std::printf("steps [ms]: setup %.1f, floor points %.1f, distance %.1f, contacts %.1f, vertex/surface %.1f, "
-                "edge/edge %.1f, stability %.1f, local optimisation %.1f, robustness %.1f\n",
-                st.steps.setup, st.steps.floor_points, st.steps.first_contact, st.steps.contact_points,
-                st.steps.tilt_vertex, st.steps.tilt_edge, st.steps.stability, st.steps.local_optimisation,
-                st.robustness_ms);
+    printReport(object_spec, object, area_spec, area, c, r);
 #ifdef PLACE_PLANNER_HAVE_VALIDATION
     if (verify_k > 0) {
       // Within what is left of the plan's budget (none: no limit).
-      const double budget = validation::remainingBudgetMs(c.time_budget_ms, st.total_ms);
-      const validation::VerifyStats v =
-          validation::verifyTopK(object, area, c, r, verify_k, budget, c.threads);
+      const double budget = validation::remainingBudgetMs(c.time_budget_ms, r.stats.total_ms);
+      const validation::VerifyStats v = validation::verifyTopK(object, area, c, r, verify_k, budget, c.threads);
       std::printf("physics (Bullet): %d of %d checked, %d stayed, %d moved down the ranking; "
                   "%.1f ms (shapes %.1f ms, %.1f ms per candidate, %d threads)\n",
-                  v.checked, v.selected, v.stayed, v.demoted, v.total_ms, v.shape_ms,
-                  v.per_check_ms, v.threads);
+                  v.checked, v.selected, v.stayed, v.demoted, v.total_ms, v.shape_ms, v.per_check_ms, v.threads);
     }
 #endif
-    std::printf("%4s %7s %6s %6s %7s %-14s %26s %32s %8s\n", "rank", "quality", "stable", "robust",
-                "physics", "start", "position [m]", "orientation xyzw", "contacts");
-    for (size_t i = 0; i < r.candidates.size(); ++i) {
-      const auto& k = r.candidates[i];
-      const Eigen::Quaterniond q(k.X_WO.linear());
-      const Eigen::Vector3d p = k.X_WO.translation();
-      std::printf("%4zu %7.3f %6s %6s %7s %-14s (%7.3f %7.3f %7.3f) (%6.3f %6.3f %6.3f %6.3f) %8zu\n",
-                  i + 1, k.quality, k.stable ? "yes" : "no", robustnessCell(k.robustness).c_str(),
-                  physicsCell(k.physics).c_str(), toString(k.start), p.x(), p.y(), p.z(), q.x(),
-                  q.y(), q.z(), q.w(), k.contacts.size());
+    printTable(r);
+    if (json_file) {
+      // Invalid UTF-8 in a path (any bytes are legal there) becomes U+FFFD rather than an
+      // exception: the answer is still written.
+      json_file->write(resultJson(object_spec, area_spec, c, r).dump(-1, ' ', false, Json::error_handler_t::replace) +
+                       "\n");
     }
-    const PlanOutcome outcome = r.outcome();
-    if (args.count("--json")) {
-      std::ofstream o(args["--json"]);
-      if (!o) throw std::runtime_error("cannot write " + args["--json"]);
-      o.precision(9);
-      o << "{\"object\": \"" << jsonEscaped(args["--object"]) << "\", \"area\": \""
-        << jsonEscaped(args["--area"]) << "\", \"outcome\": \"" << toString(outcome)
-        << "\", \"stable_candidates\": " << r.stableCount()
-        << ", \"planning_ms\": " << st.total_ms << ", \"first_stable_ms\": " << st.first_stable_ms
-        << ", \"floor_points\": " << st.floor_points_total
-        << ", \"floor_points_done\": " << st.floor_points_done << ", \"gravity\": ";
-      vecJson(o, c.gravity);
-      o << ", \"warnings\": [";
-      for (size_t i = 0; i < r.warnings.size(); ++i)
-        o << (i ? ", " : "") << "\"" << jsonEscaped(r.warnings[i]) << "\"";
-      o << "], \"candidates\": [";
-      for (size_t i = 0; i < r.candidates.size(); ++i) {
-        const auto& k = r.candidates[i];
-        o << (i ? ", " : "") << "{\"position\": ";
-        vecJson(o, k.X_WO.translation());
-        o << ", \"orientation_xyzw\": ";
-        quatJson(o, k.X_WO.linear());
-        o << ", \"quality\": " << k.quality << ", \"stable\": " << (k.stable ? "true" : "false")
-          << ", \"start\": \"" << toString(k.start) << "\", \"robustness\": {\"trials\": "
-          << k.robustness.trials << ", \"held\": " << k.robustness.held
-          << ", \"share\": " << k.robustness.share()
-          << ", \"min_tipping_angle\": " << k.robustness.min_tipping_angle
-          << "}, \"physics\": {\"checked\": " << (k.physics.checked ? "true" : "false")
-          << ", \"stayed\": " << (k.physics.stayed ? "true" : "false")
-          << ", \"moved_m\": " << k.physics.moved_m << ", \"turned_deg\": " << k.physics.turned_deg
-          << "}, \"floor_point\": ";
-        vecJson(o, k.floor_point_W);
-        o << ", \"contacts\": [";
-        for (size_t j = 0; j < k.contacts.size(); ++j) {
-          o << (j ? ", " : "") << "{\"p\": ";
-          vecJson(o, k.contacts[j].p_W);
-          o << ", \"n\": ";
-          vecJson(o, k.contacts[j].n_W);
-          o << "}";
-        }
-        o << "], \"intermediate_poses\": [";
-        for (size_t j = 0; j < k.intermediate_poses.size(); ++j) {
-          o << (j ? ", " : "") << "{\"position\": ";
-          vecJson(o, k.intermediate_poses[j].translation());
-          o << ", \"orientation_xyzw\": ";
-          quatJson(o, k.intermediate_poses[j].linear());
-          o << "}";
-        }
-        o << "]}";
-      }
-      o << "]}\n";
-    }
-    // The answer in one line, always last on stdout (scripts read it with tail -1).
-    const int n_stable = r.stableCount();
-    switch (outcome) {
-      case PlanOutcome::kStable:
-        std::printf("outcome: stable (%d stable candidate%s)\n", n_stable, n_stable == 1 ? "" : "s");
-        break;
-      case PlanOutcome::kTimedOutWithStable:
-        std::printf("partial answer: the time budget of %.1f ms ran out after %d of %d floor points\n",
-                    c.time_budget_ms, st.floor_points_done, st.floor_points_total);
-        std::printf("outcome: timed_out_partial (%d stable candidate%s so far)\n", n_stable,
-                    n_stable == 1 ? "" : "s");
-        break;
-      case PlanOutcome::kNoStable:
-        std::printf("outcome: no_stable_pose (%zu candidates, none stable, all %d floor points searched)\n",
-                    r.candidates.size(), st.floor_points_total);
-        break;
-      case PlanOutcome::kTimedOutNone:
-      case PlanOutcome::kCancelled:
-        std::printf("outcome: %s (nothing stable in %d of %d floor points within %.1f ms)\n",
-                    toString(outcome), st.floor_points_done, st.floor_points_total, c.time_budget_ms);
-        break;
-    }
-    return exitCode(outcome);
+  } catch (const OutputError& e) {
+    return fail(kExitOutputError, "output_error", e.what());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "place_planner_cli: error: %s\n", e.what());
-    std::printf("outcome: bad_input\n");
-    return 2;
+    // InputError, MeshError, std::invalid_argument from the planner (a config it refuses) and
+    // std::runtime_error (e.g. CUDA failing mid-plan) all mean this input cannot be planned.
+    return fail(kExitBadInput, "bad_input", e.what());
   }
+  printOutcome(c, r);
+  return exitCode(r.outcome());
 }

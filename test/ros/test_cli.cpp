@@ -1,44 +1,104 @@
 // place_planner_cli as a script sees it: the exit code, the last line of stdout ("outcome: ..."),
-// the JSON's outcome and the physics column of --verify. Runs the built binary (PP_CLI_BINARY)
-// on built-in scenes and on a steep slope written to a temporary PLY file.
+// the error line on stderr, and the JSON file (parsed, never matched as text). Runs the built
+// binary (PP_CLI_BINARY) on built-in scenes and on a steep slope written to a temporary PLY file.
+#include <dirent.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "place_planner/cuda_backend.h"
 #include "place_planner/mesh_io.h"
 #include "place_planner/scenes.h"
 
 namespace place_planner {
 namespace {
 
+using nlohmann::json;
+
 struct CliRun {
   int code = -1;
   std::string out;  // stdout
+  std::string err;  // stderr
   std::string last_line;
 };
 
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A fresh directory of this test process.
+std::string tempDir(const std::string& name) {
+  const std::string d = "/tmp/pp_cli_test_" + std::to_string(getpid()) + "_" + name;
+  mkdir(d.c_str(), 0755);
+  return d;
+}
+
+std::vector<std::string> listDir(const std::string& dir) {
+  std::vector<std::string> names;
+  if (DIR* d = opendir(dir.c_str())) {
+    while (const dirent* e = readdir(d)) {
+      const std::string n = e->d_name;
+      if (n != "." && n != "..") names.push_back(n);
+    }
+    closedir(d);
+  }
+  return names;
+}
+
+// Runs the CLI with exactly these arguments (no shell: any bytes may be in a path), under
+// `timeout 120`. `shell_script` (optional) is a bash script that runs the command line "$@".
 // From the principal axis unless args say otherwise: the cube then rests on a face whatever the
-// auto mode's order (these tests are about codes and lines, not start orientations).
-CliRun cli(const std::string& args) {
+// auto mode's order (these tests are about codes, lines and files, not start orientations).
+CliRun cli(std::vector<std::string> args, const std::string& shell_script = "") {
+  bool has_orientation = false;
+  for (const auto& a : args) has_orientation |= a == "--orientation" || a == "--help";
+  if (!has_orientation) args.insert(args.end(), {"--orientation", "principal_axis"});
+  std::vector<std::string> argv;
+  if (!shell_script.empty()) argv = {"/bin/bash", "-c", shell_script, "bash"};
+  argv.insert(argv.end(), {"timeout", "120", PP_CLI_BINARY});
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> cargv;
+  for (auto& a : argv) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+
+  char out_name[] = "/tmp/pp_cli_out_XXXXXX";
+  char err_name[] = "/tmp/pp_cli_err_XXXXXX";
+  const int out_fd = mkstemp(out_name), err_fd = mkstemp(err_name);
   CliRun r;
-  const std::string orientation =
-      args.find("--orientation") == std::string::npos ? " --orientation principal_axis" : "";
-  const std::string command =
-      "timeout 120 " + std::string(PP_CLI_BINARY) + " " + args + orientation + " 2>/dev/null";
-  FILE* pipe = popen(command.c_str(), "r");
-  EXPECT_NE(pipe, nullptr);
-  if (!pipe) return r;
-  char buf[1024];
-  while (fgets(buf, sizeof buf, pipe)) r.out += buf;
-  const int status = pclose(pipe);
+  EXPECT_GE(out_fd, 0);
+  EXPECT_GE(err_fd, 0);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(out_fd, 1);
+    dup2(err_fd, 2);
+    execvp(cargv[0], cargv.data());
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  close(out_fd);
+  close(err_fd);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = readFile(out_name);
+  r.err = readFile(err_name);
+  std::remove(out_name);
+  std::remove(err_name);
   std::istringstream is(r.out);
   for (std::string line; std::getline(is, line);) {
     if (!line.empty()) r.last_line = line;
@@ -47,16 +107,10 @@ CliRun cli(const std::string& args) {
 }
 
 bool startsWith(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 std::string tempPath(const std::string& name) {
   return "/tmp/pp_cli_test_" + std::to_string(getpid()) + "_" + name;
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // A 1 x 1 m plane tilted 40 degrees: with mu = 0.05 (tan 40 = 0.84) nothing can rest on it.
@@ -69,33 +123,42 @@ std::string steepSlope() {
   return path;
 }
 
+const std::vector<std::string> kCubeOnTable = {"--object", "builtin:cube", "--area", "builtin:table"};
+
+std::vector<std::string> cubeOnTable(const std::vector<std::string>& more) {
+  std::vector<std::string> a = kCubeOnTable;
+  a.insert(a.end(), more.begin(), more.end());
+  return a;
+}
+
 TEST(PlacePlannerCli, StablePoseExitsZeroWithOutcomeLineAndVerifiedTopTwo) {
-  const std::string json = tempPath("cube_table.json");
-  const CliRun r = cli("--object builtin:cube --area builtin:table --verify 2 --json " + json);
-  EXPECT_EQ(r.code, 0) << r.out;
+  const std::string path = tempPath("cube_table.json");
+  const CliRun r = cli(cubeOnTable({"--verify", "2", "--json", path}));
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_TRUE(startsWith(r.last_line, "outcome: stable (")) << r.last_line;
-  EXPECT_NE(r.out.find("physics"), std::string::npos) << "no physics column";
-  EXPECT_NE(r.out.find("robust"), std::string::npos) << "no robustness column";
-  const std::string j = readFile(json);
-  std::remove(json.c_str());
-  EXPECT_NE(j.find("\"outcome\": \"stable\""), std::string::npos) << j.substr(0, 300);
-  // One "physics" object per candidate, in rank order: the best two were simulated and a cube
-  // resting on a face of the table stays put; the third (if any) was not simulated.
-  std::vector<std::string> physics;
-  for (size_t at = j.find("\"physics\": {"); at != std::string::npos;
-       at = j.find("\"physics\": {", at + 1)) {
-    physics.push_back(j.substr(at, 60));
-  }
-  ASSERT_GE(physics.size(), 2u) << "the cube on the table has at least two stable candidates";
+  EXPECT_TRUE(contains(r.out, "physics")) << "no physics column";
+  EXPECT_TRUE(contains(r.out, "robust")) << "no robustness column";
+  const json j = json::parse(readFile(path));
+  std::remove(path.c_str());
+  EXPECT_EQ(j.at("outcome"), "stable");
+  EXPECT_EQ(j.at("object"), "builtin:cube");
+  EXPECT_EQ(j.at("gravity"), json::array({0.0, 0.0, -1.0}));
+  const json& k = j.at("candidates");
+  ASSERT_GE(k.size(), 2u) << "the cube on the table has at least two stable candidates";
+  EXPECT_GT(j.at("stable_candidates").get<int>(), 0);
+  // In rank order: the best two were simulated and a cube resting on a face of the table
+  // stays put; the third (if any) was not simulated.
   for (int i = 0; i < 2; ++i) {
-    EXPECT_TRUE(startsWith(physics[i], "\"physics\": {\"checked\": true, \"stayed\": true"))
-        << "candidate " << i + 1 << ": " << physics[i];
+    EXPECT_TRUE(k[i].at("physics").at("checked").get<bool>()) << "candidate " << i + 1;
+    EXPECT_TRUE(k[i].at("physics").at("stayed").get<bool>()) << "candidate " << i + 1;
+    EXPECT_EQ(k[i].at("orientation_xyzw").size(), 4u);
+    EXPECT_EQ(k[i].at("position").size(), 3u);
   }
-  if (physics.size() > 2) EXPECT_TRUE(startsWith(physics[2], "\"physics\": {\"checked\": false")) << physics[2];
+  if (k.size() > 2) EXPECT_FALSE(k[2].at("physics").at("checked").get<bool>());
 }
 
 TEST(PlacePlannerCli, NothingStableOnSteepSlopeExitsOne) {
-  const CliRun r = cli("--object builtin:cube --area " + steepSlope() + " --friction 0.05");
+  const CliRun r = cli({"--object", "builtin:cube", "--area", steepSlope(), "--friction", "0.05"});
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_TRUE(startsWith(r.last_line, "outcome: no_stable_pose")) << r.last_line;
 }
@@ -103,8 +166,8 @@ TEST(PlacePlannerCli, NothingStableOnSteepSlopeExitsOne) {
 // The slope again, with a fine grid of floor points that cannot be searched in 0.01 ms: the
 // budget runs out with nothing stable.
 TEST(PlacePlannerCli, TimeoutWithNothingStableExitsThree) {
-  const CliRun r = cli("--object builtin:cube --area " + steepSlope() +
-                    " --friction 0.05 --spacing 0.01 --budget-ms 0.01");
+  const CliRun r = cli({"--object", "builtin:cube", "--area", steepSlope(), "--friction", "0.05", "--spacing",
+                        "0.01", "--budget-ms", "0.01"});
   EXPECT_EQ(r.code, 3) << r.out;
   EXPECT_TRUE(startsWith(r.last_line, "outcome: timed_out (")) << r.last_line;
 }
@@ -112,15 +175,15 @@ TEST(PlacePlannerCli, TimeoutWithNothingStableExitsThree) {
 // 1 cm floor points on the table (thousands: seconds of search); the first stable pose comes
 // within milliseconds, so 300 ms end with a partial answer.
 TEST(PlacePlannerCli, TimeoutWithStableIsPartialAndExitsZero) {
-  const CliRun r = cli("--object builtin:cube --area builtin:table --spacing 0.01 --budget-ms 300");
+  const CliRun r = cli(cubeOnTable({"--spacing", "0.01", "--budget-ms", "300"}));
   EXPECT_EQ(r.code, 0) << r.out;
   EXPECT_TRUE(startsWith(r.last_line, "outcome: timed_out_partial (")) << r.last_line;
-  EXPECT_NE(r.out.find("\npartial answer: "), std::string::npos) << r.out;
+  EXPECT_TRUE(contains(r.out, "\npartial answer: ")) << r.out;
 }
 
 // Whatever a tiny budget leaves, the code and the line agree: 0 with a partial answer or 3.
 TEST(PlacePlannerCli, TinyBudgetIsPartialOrTimedOutNeverElse) {
-  const CliRun r = cli("--object builtin:cube --area builtin:table --budget-ms 1");
+  const CliRun r = cli(cubeOnTable({"--budget-ms", "1"}));
   if (r.code == 0) {
     EXPECT_TRUE(startsWith(r.last_line, "outcome: timed_out_partial (")) << r.last_line;
   } else {
@@ -129,27 +192,204 @@ TEST(PlacePlannerCli, TinyBudgetIsPartialOrTimedOutNeverElse) {
   }
 }
 
-TEST(PlacePlannerCli, BadInputExitsTwo) {
-  for (const std::string args :
-       {"--object builtin:cube --area builtin:table --friction abc",
-        "--object builtin:cube --area builtin:table --robust-shift 1.0",  // out of range
-        "--object builtin:cube --area builtin:table --orientation upside_down",
-        "--object builtin:cube --area builtin:table --no-such-option 1", "--object builtin:cube",
-        "--object builtin:nothing --area builtin:table"}) {
+// Each bad input exits 2 with "outcome: bad_input" last and an error line naming what is wrong.
+TEST(PlacePlannerCli, BadInputExitsTwoNamingTheFlag) {
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {cubeOnTable({"--friction", "abc"}), "--friction"},
+      {cubeOnTable({"--friction", "nan"}), "--friction"},
+      {cubeOnTable({"--robust-shift", "1.0"}), "--robust-shift"},  // out of range (validate)
+      {cubeOnTable({"--spacing", "0"}), "--spacing"},
+      {cubeOnTable({"--gravity", "0,0,0"}), "--gravity"},
+      {cubeOnTable({"--gravity", "1,2"}), "--gravity"},
+      {cubeOnTable({"--approach", "x,y,z"}), "--approach"},
+      {cubeOnTable({"--orientation", "upside_down"}), "--orientation"},
+      {cubeOnTable({"--backend", "quantum"}), "--backend"},
+      {cubeOnTable({"--verify", "-1"}), "--verify"},
+      {cubeOnTable({"--no-such-option", "1"}), "--no-such-option"},
+      {{"--object", "builtin:cube"}, "--area"},
+      {{"--object", "builtin:nothing", "--area", "builtin:table"}, "--object"},
+      {{"--object", "builtin:cube", "--area", "/nonexistent/area.ply"}, "/nonexistent/area.ply"},
+  };
+  for (const auto& [args, named] : cases) {
     const CliRun r = cli(args);
-    EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
-    EXPECT_EQ(r.last_line, "outcome: bad_input") << args;
+    std::string line;
+    for (const auto& a : args) line += a + " ";
+    EXPECT_EQ(r.code, 2) << line << "\n" << r.out;
+    EXPECT_EQ(r.last_line, "outcome: bad_input") << line;
+    EXPECT_TRUE(contains(r.err, "error: ")) << line << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, named)) << line << ": the error does not name " << named << ": " << r.err;
   }
 }
 
-TEST(PlacePlannerCli, NewFlagsAreAccepted) {
-  const CliRun r = cli("--object builtin:cube --area builtin:table --orientation auto --robust-shift 0.002 "
-                    "--robust-tilt-deg 2 --robust-com-offset 0.02 --no-robust-check --max-candidates 3");
+// Integer options take integers: no rounding of 2.5, no wrap-around of 10^11, named in the error.
+TEST(PlacePlannerCli, BadIntegerNamesTheFlag) {
+  for (const std::string flag : {"--max-rotations", "--max-resting-faces", "--max-candidates", "--threads", "--verify"}) {
+    for (const std::string value : {"2.5", "99999999999", "3x", "abc"}) {
+      const CliRun r = cli(cubeOnTable({flag, value}));
+      EXPECT_EQ(r.code, 2) << flag << " " << value << "\n" << r.out;
+      EXPECT_EQ(r.last_line, "outcome: bad_input") << flag << " " << value;
+      EXPECT_TRUE(contains(r.err, flag)) << flag << " " << value << ": " << r.err;
+    }
+  }
+}
+
+TEST(PlacePlannerCli, EveryOptionIsAccepted) {
+  const std::string path = tempPath("all_options.json");
+  const CliRun r = cli(cubeOnTable({"--gravity", "0,0,-2", "--approach", "0,0,-1", "--friction", "0.5", "--spacing",
+                                    "0.2", "--max-rotations", "4", "--orientation", "auto", "--max-resting-faces", "3",
+                                    "--robust-shift", "0.002", "--robust-tilt-deg", "2", "--robust-com-offset", "0.02",
+                                    "--robust-min-share", "0.9", "--budget-ms", "20000", "--max-candidates", "3",
+                                    "--threads", "1", "--backend", "cpu", "--verify", "1", "--json", path}));
   // Accepted (not 2); whether the auto start finds the cube's faces is the core's business.
-  EXPECT_TRUE(r.code == 0 || r.code == 1) << r.out;
-  EXPECT_TRUE(startsWith(r.last_line, r.code == 0 ? "outcome: stable (" : "outcome: no_stable_pose"))
-      << r.last_line;
-  EXPECT_NE(r.out.find("orientation auto"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.code == 0 || r.code == 1) << r.out << r.err;
+  EXPECT_TRUE(startsWith(r.last_line, r.code == 0 ? "outcome: stable (" : "outcome: no_stable_pose")) << r.last_line;
+  EXPECT_TRUE(contains(r.out, "orientation auto")) << r.out;
+  const json j = json::parse(readFile(path));
+  std::remove(path.c_str());
+  EXPECT_EQ(j.at("backend"), "cpu");
+  EXPECT_LE(j.at("candidates").size(), 3u) << "--max-candidates 3";
+  EXPECT_EQ(j.at("gravity"), json::array({0.0, 0.0, -2.0})) << "as given, the planner normalises";
+
+  const CliRun no_robust = cli(cubeOnTable({"--no-robust-check", "--gravity", "auto"}));
+  EXPECT_EQ(no_robust.code, 0) << no_robust.out << no_robust.err;
+  // The table's top faces up: gravity straight down (the signs of the zeros vary).
+  EXPECT_TRUE(contains(no_robust.out, "gravity (auto): (")) << no_robust.out;
+  EXPECT_TRUE(contains(no_robust.out, ".000, -1.000), the largest flat region")) << no_robust.out;
+  // Not checked: the robustness column says so.
+  EXPECT_FALSE(contains(no_robust.out, "/12")) << no_robust.out;
+}
+
+TEST(PlacePlannerCli, HelpListsEveryOptionAndTheExitCodes) {
+  const CliRun r = cli({"--help"});
+  EXPECT_EQ(r.code, 0);
+  for (const std::string flag :
+       {"--object", "--area", "--gravity", "--approach", "--friction", "--spacing", "--max-rotations", "--orientation",
+        "--max-resting-faces", "--robust-shift", "--robust-tilt-deg", "--robust-com-offset", "--robust-min-share",
+        "--no-robust-check", "--budget-ms", "--max-candidates", "--threads", "--backend", "--verify", "--json"}) {
+    EXPECT_TRUE(contains(r.out, flag)) << flag;
+  }
+  for (const std::string code : {"  0  stable", "  1  the search completed", "  2  bad input", "  3  the budget",
+                                 "  4  planned, but the --json"}) {
+    EXPECT_TRUE(contains(r.out, code)) << code << "\n" << r.out;
+  }
+}
+
+// gpu means cuda: never a silent fall-back to the CPU.
+TEST(PlacePlannerCli, BackendGpuIsCudaOrAnError) {
+  std::string why;
+  const bool have_cuda = cuda::available(&why);
+  for (const std::string name : {"gpu", "cuda"}) {
+    const std::string path = tempPath("backend.json");
+    const CliRun r = cli(cubeOnTable({"--backend", name, "--no-robust-check", "--json", path}));
+    if (have_cuda) {
+      EXPECT_EQ(r.code, 0) << r.err;
+      EXPECT_EQ(json::parse(readFile(path)).at("backend"), "cuda");
+    } else {
+      EXPECT_EQ(r.code, 2) << name << ": " << r.out;
+      EXPECT_TRUE(contains(r.err, "--backend " + name + ": the CUDA backend is unavailable")) << r.err;
+      EXPECT_FALSE(contains(r.out, "backend cpu")) << "planned on the CPU anyway";
+    }
+    std::remove(path.c_str());
+  }
+}
+
+// Six processes write one path at once while this test reads it: every read is a whole JSON
+// document (the old file or a new one), never a prefix, and no temporary file is left.
+TEST(PlacePlannerCli, ConcurrentWritesToOneJsonPathAlwaysLeaveValidJson) {
+  const std::string dir = tempDir("concurrent");
+  const std::string path = dir + "/out.json";
+  std::atomic<bool> done{false};
+  int reads = 0, broken = 0;
+  std::string broken_sample;
+  std::thread reader([&] {
+    while (!done) {
+      std::ifstream in(path, std::ios::binary);
+      if (in) {
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        ++reads;
+        if (!json::accept(text)) {
+          ++broken;
+          broken_sample = text.substr(0, 120) + " ... (" + std::to_string(text.size()) + " bytes)";
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  });
+  std::vector<std::thread> writers;
+  std::vector<CliRun> runs(6);
+  for (int i = 0; i < 6; ++i) {
+    writers.emplace_back([&, i] {
+      runs[i] = cli(cubeOnTable({"--no-robust-check", "--threads", "1", "--max-candidates", std::to_string(i + 3),
+                                 "--json", path}));
+    });
+  }
+  for (auto& w : writers) w.join();
+  done = true;
+  reader.join();
+  for (const auto& r : runs) EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(broken, 0) << broken << " of " << reads << " reads were not valid JSON, e.g. " << broken_sample;
+  EXPECT_GT(reads, 0);
+  const json j = json::parse(readFile(path));
+  EXPECT_EQ(j.at("outcome"), "stable");
+  EXPECT_EQ(listDir(dir), std::vector<std::string>{"out.json"}) << "temporary files left behind";
+  std::remove(path.c_str());
+  rmdir(dir.c_str());
+}
+
+// A destination that cannot be written is bad input, found before any planning.
+TEST(PlacePlannerCli, UnwritableJsonPathExitsTwoBeforePlanning) {
+  const std::string dir = tempDir("unwritable");
+  for (const std::string path : {std::string("/nonexistent/dir/out.json"), dir}) {
+    const CliRun r = cli(cubeOnTable({"--json", path}));
+    EXPECT_EQ(r.code, 2) << path << ": " << r.out;
+    EXPECT_EQ(r.last_line, "outcome: bad_input") << path;
+    EXPECT_TRUE(contains(r.err, "--json")) << r.err;
+    EXPECT_TRUE(contains(r.err, path)) << r.err;
+    EXPECT_FALSE(contains(r.out, "floor points")) << "it planned first: " << r.out;
+  }
+  rmdir(dir.c_str());
+}
+
+// A write that fails after planning (the disk fills: here a 1 KiB file size limit, EFBIG) exits
+// 4 with "outcome: output_error"; the file that was there is left whole, and no temporary file.
+TEST(PlacePlannerCli, WriteFailureExitsFourAndKeepsTheOldFile) {
+  const std::string dir = tempDir("full");
+  const std::string path = dir + "/out.json";
+  const std::string old_text = "{\"old\": true}\n";
+  std::ofstream(path) << old_text;
+  // SIGXFSZ ignored, so the write returns EFBIG instead of killing the process; the limit only
+  // for the CLI, whose stdout goes through cat to the (unlimited) capture file.
+  const CliRun r = cli(cubeOnTable({"--no-robust-check", "--json", path}),
+                       "trap '' XFSZ; (ulimit -f 1; exec \"$@\") | cat; exit ${PIPESTATUS[0]}");
+  EXPECT_EQ(r.code, 4) << r.out << r.err;
+  EXPECT_EQ(r.last_line, "outcome: output_error");
+  EXPECT_TRUE(contains(r.err, "cannot write " + path)) << r.err;
+  EXPECT_TRUE(contains(r.out, "floor points")) << "the plan ran and was reported: " << r.out;
+  EXPECT_EQ(readFile(path), old_text);
+  EXPECT_EQ(listDir(dir), std::vector<std::string>{"out.json"}) << "temporary files left behind";
+  std::remove(path.c_str());
+  rmdir(dir.c_str());
+}
+
+// Paths are bytes: quotes, backslashes and control characters are escaped; bytes that are not
+// UTF-8 become U+FFFD. The file always parses.
+TEST(PlacePlannerCli, JsonEscapesOddStrings) {
+  const std::string dir = tempDir("odd names");
+  const std::string quoted = dir + "/cu\"be\\ \t'x'.ply";
+  const std::string latin1 = dir + "/w\xfcrfel.ply";  // ISO 8859-1, not UTF-8
+  saveMeshPly(scenes::box(0.05, 0.05, 0.05), quoted);
+  saveMeshPly(scenes::box(0.05, 0.05, 0.05), latin1);
+  const std::string path = dir + "/out.json";
+  CliRun r = cli({"--object", quoted, "--area", "builtin:table", "--no-robust-check", "--json", path});
+  EXPECT_EQ(r.code, 0) << r.err;
+  json j = json::parse(readFile(path));
+  EXPECT_EQ(j.at("object"), quoted);
+  r = cli({"--object", latin1, "--area", "builtin:table", "--no-robust-check", "--json", path});
+  EXPECT_EQ(r.code, 0) << r.err;
+  j = json::parse(readFile(path));
+  EXPECT_EQ(j.at("object"), dir + "/w\xef\xbf\xbdrfel.ply");
+  for (const auto& p : {quoted, latin1, path}) std::remove(p.c_str());
+  rmdir(dir.c_str());
 }
 
 }  // namespace

@@ -203,8 +203,7 @@ TEST(MeshIoHardening, LoadMeshReadsTheSameAsParseMesh) {
 }
 
 // ------------------------------------------------------------------ findings in the planner
-// Bugs the planner target found in files this test's owner does not own; DISABLED_ until the
-// owner fixes them (then drop the prefix and the workaround named in fuzz_targets.cpp).
+// Bugs the fuzz targets found in the core, fixed there; these tests keep them fixed.
 
 // mesh.cpp buildMesh accepts vertices from about 1e77 on (the fuzzers' first finding, in all
 // three formats, and in a float64 PolygonMesh: e.g. "v 0 0 1e308" in an OBJ): squared lengths overflow, so the patch normals
@@ -212,7 +211,7 @@ TEST(MeshIoHardening, LoadMeshReadsTheSameAsParseMesh) {
 // is handed NaN. Expected: a MeshError naming the vertex (as for NaN/Inf coordinates), or
 // finite properties. fuzz_targets.cpp skips such meshes (kKnownOverflowCoordinate) until fixed;
 // the inputs are in regressions/known/.
-TEST(FuzzFindings, DISABLED_HugeCoordinatesAreRefusedOrFinite) {
+TEST(FuzzFindings, HugeCoordinatesAreRefusedOrFinite) {
   for (const double s : {1e77, 1e150, 1e308}) {
     std::ostringstream obj;
     obj << "v 0 0 0\nv " << s << " 0 0\nv 0 " << s << " 0\nv 0 0 " << s << "\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
@@ -234,7 +233,7 @@ TEST(FuzzFindings, DISABLED_HugeCoordinatesAreRefusedOrFinite) {
 // squared), so the four degenerate triangles are kept and the mesh has surface area 0 with
 // arbitrary normals. Expected: a MeshError (nothing but degenerate polygons), as at the origin.
 // Summing relative to the polygon's first vertex would fix it.
-TEST(FuzzFindings, DISABLED_DegenerateFarFromOriginIsRefused) {
+TEST(FuzzFindings, DegenerateFarFromOriginIsRefused) {
   const double o = -2.8483943054992686e+18;
   const std::vector<Eigen::Vector3d> v = {{-2.8483943054736097e+18, o, o}, {-2.8483926325171011e+18, o, o},
                                           {o, o, o}, {o, o, o}};
@@ -243,8 +242,7 @@ TEST(FuzzFindings, DISABLED_DegenerateFarFromOriginIsRefused) {
 
 // The original inputs of the findings above (libFuzzer's crash files, regressions/known/<target>/)
 // through the targets without their workarounds.
-TEST(FuzzFindings, DISABLED_KnownFindingsReplay) {
-  fuzz::skipKnownBugs() = false;
+TEST(FuzzFindings, KnownFindingsReplay) {
   for (const std::string target : {"ply_text", "ply_binary", "obj", "stl", "planner"
 #ifdef PP_FUZZ_WITH_ROS
                                     , "polygon_mesh"
@@ -252,7 +250,6 @@ TEST(FuzzFindings, DISABLED_KnownFindingsReplay) {
        }) {
     replay(target, "regressions/known", 0);
   }
-  fuzz::skipKnownBugs() = true;
 }
 
 // ranking.cpp bounds the robustness checks with `checked < 4 * config.max_candidates`: for
@@ -260,11 +257,20 @@ TEST(FuzzFindings, DISABLED_KnownFindingsReplay) {
 // 1124106240"), in practice to <= 0, so no stable pose is checked and none is returned
 // stable: a cube on a table comes out "no_stable_pose" (also place_planner_cli
 // --max-candidates 1073741824). validate() accepts any max_candidates >= 1.
-TEST(FuzzFindings, DISABLED_HugeMaxCandidatesStillFindsStablePoses) {
+// Fixed: validate() bounds max_candidates to 1 .. 100000 (a named error), and the bound is
+// computed in long.
+TEST(FuzzFindings, HugeMaxCandidatesIsRefusedAndTheLimitStillFindsStablePoses) {
   PlannerConfig c;
   c.orientation = OrientationMode::kPrincipalAxis;
   c.threads = 1;
   c.max_candidates = 1 << 30;
+  try {
+    Planner().plan(scenes::box(0.05, 0.05, 0.05), scenes::table(), c);
+    ADD_FAILURE() << "max_candidates = 2^30 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_candidates"), std::string::npos) << e.what();
+  }
+  c.max_candidates = 100000;
   const PlanResult r = Planner().plan(scenes::box(0.05, 0.05, 0.05), scenes::table(), c);
   EXPECT_EQ(r.outcome(), PlanOutcome::kStable);
   EXPECT_GT(r.stableCount(), 0);

@@ -6,6 +6,8 @@ set_target_properties(place_planner_gripper PROPERTIES POSITION_INDEPENDENT_CODE
 target_include_directories(place_planner_gripper PUBLIC ${urdfdom_INCLUDE_DIRS})
 target_link_libraries(place_planner_gripper PUBLIC place_planner_core ${urdfdom_LIBRARIES})
 target_compile_options(place_planner_gripper PRIVATE ${PP_WARN})
+# The CLI takes the gripper too (--urdf, --gripper-links).
+target_link_libraries(place_planner_cli place_planner_gripper)
 
 if(CATKIN_ENABLE_TESTING)
   catkin_add_gtest(gripper_tests ${PROJECT_SOURCE_DIR}/test/gripper/test_gripper.cpp

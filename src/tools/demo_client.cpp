@@ -32,6 +32,7 @@ const char* codeName(int code) {
     case R::INVALID_GOAL: return "INVALID_GOAL";
     case R::PREEMPTED: return "PREEMPTED";
     case R::TIMED_OUT: return "TIMED_OUT";
+    case R::INTERNAL_ERROR: return "INTERNAL_ERROR";
     default: return "UNKNOWN";
   }
 }

@@ -19,6 +19,7 @@
 
 #include "place_planner/area_up.h"
 #include "place_planner/cuda_backend.h"
+#include "place_planner/gripper.h"
 #include "place_planner/mesh_io.h"
 #include "place_planner/planner.h"
 #include "place_planner/scenes.h"
@@ -84,6 +85,21 @@ Eigen::Vector3d parseVector(const std::string& flag, const std::string& s) {
   return v;
 }
 
+// "x,y,z,qx,qy,qz,qw": the pose of the gripper frame F in the object frame O.
+Eigen::Isometry3d parsePose(const std::string& flag, const std::string& s) {
+  const std::vector<std::string> parts = CLI::detail::split(s, ',');
+  double v[7] = {0, 0, 0, 0, 0, 0, 0};
+  bool ok = parts.size() == 7;
+  for (size_t i = 0; ok && i < 7; ++i) ok = CLI::detail::lexical_cast(parts[i], v[i]) && std::isfinite(v[i]);
+  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+  if (!ok || std::abs(q.norm() - 1.0) > 1e-3)
+    throw CLI::ValidationError(flag, "expects x,y,z,qx,qy,qz,qw with a unit quaternion (got '" + s + "')");
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = q.normalized().toRotationMatrix();
+  X.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return X;
+}
+
 // validate() names the config field; the user typed a flag: name both.
 const std::map<std::string, std::string> kFlagOfField = {
     {"gravity", "--gravity"},
@@ -99,6 +115,21 @@ const std::map<std::string, std::string> kFlagOfField = {
     {"time_budget_ms", "--budget-ms"},
     {"max_candidates", "--max-candidates"},
     {"threads", "--threads"},
+    {"max_triangles", "--max-triangles"},
+    {"max_floor_points", "--max-floor-points"},
+    {"max_tree_nodes", "--max-tree-nodes"},
+    {"max_model_mb", "--max-model-mb"},
+    {"max_object_size", "--max-object-size"},
+    {"max_area_size", "--max-area-size"},
+    {"max_gripper_tilt_deg", "--max-gripper-tilt-deg"},
+    {"gripper_min_clearance", "--gripper-min-clearance"},
+    {"approach_distance", "--approach-distance"},
+    {"approach_min_distance", "--approach-min-distance"},
+    {"retreat_distance", "--retreat-distance"},
+    {"retreat_min_distance", "--retreat-min-distance"},
+    {"min_edge_clearance", "--min-edge-clearance"},
+    {"prefer_near", "--prefer-near"},
+    {"grasp", "--grasp"},
 };
 
 void validateNamingFlags(const PlannerConfig& c) {
@@ -186,6 +217,28 @@ Json quatJson(const Eigen::Matrix3d& R) {
   return Json::array({q.x(), q.y(), q.z(), q.w()});
 }
 
+// The candidate's placement (placeability.h): the PlaceLocation-shaped fields.
+Json placementJson(const Candidate& k) {
+  const Placement& p = k.placement;
+  auto motion = [](const LinearMotion& m) {
+    return Json{{"direction", vecJson(m.direction)},
+                {"min_distance", m.min_distance},
+                {"desired_distance", m.desired_distance},
+                {"free_distance", m.free_distance}};
+  };
+  Json j{{"checked", p.checked},
+         {"pre_place",
+          {{"position", vecJson(p.pre_place_W.translation())}, {"orientation_xyzw", quatJson(p.pre_place_W.linear())}}},
+         {"straight_approach", p.straight},
+         {"approach", motion(p.approach)},
+         {"retreat_in_gripper_frame", motion(p.retreat)},
+         {"gripper_clearance", p.gripper_clearance},
+         {"blocked", p.blocked}};
+  if (k.has_gripper_pose)
+    j["gripper_pose"] = {{"position", vecJson(k.X_WF.translation())}, {"orientation_xyzw", quatJson(k.X_WF.linear())}};
+  return j;
+}
+
 Json resultJson(const std::string& object, const std::string& area, const PlannerConfig& c,
                 const PlanResult& r) {
   const auto& st = r.stats;
@@ -201,6 +254,8 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
   j["backend"] = st.backend;
   j["gravity"] = vecJson(c.gravity);
   j["warnings"] = r.warnings;
+  j["gripper_rejected"] = st.gripper_rejected;
+  j["gripper_tilt_rejected"] = st.gripper_tilt_rejected;
   Json candidates = Json::array();
   for (const auto& k : r.candidates) {
     Json contacts = Json::array();
@@ -227,6 +282,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
         {"floor_point", vecJson(k.floor_point_W)},
         {"contacts", contacts},
         {"intermediate_poses", poses},
+        {"placement", placementJson(k)},
     });
   }
   j["candidates"] = candidates;
@@ -387,6 +443,74 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--json", json_path, "write the answer as JSON to this file")->type_name("OUT");
+  // Bounded work (README "Bounded work"): the limits of PlannerConfig.
+  app.add_option("--max-triangles", c.max_triangles, "per mesh; larger ones are decimated")->capture_default_str();
+  app.add_option("--max-floor-points", c.max_floor_points, "rays cast; a finer spacing is coarsened")
+      ->capture_default_str();
+  app.add_option("--max-tree-nodes", c.max_tree_nodes, "poses evaluated; the search stops there")->capture_default_str();
+  app.add_option("--max-model-mb", c.max_model_mb, "estimated model memory [MB]; above: bad input")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--max-object-size", c.max_object_size, "object across [m]; above: bad input (millimetres?)")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--max-area-size", c.max_area_size, "area across [m]; above: bad input")
+      ->check(kFinite)
+      ->capture_default_str();
+  // The budget in seconds, as the node takes it; --budget-ms is the same in milliseconds.
+  app.add_option_function<double>(
+         "--budget-s", [&](double s) { c.time_budget_ms = 1000.0 * s; }, "time budget [s], 0 = none")
+      ->check(kFinite);
+  // Manipulation (doc/manipulation.md): the gripper from its URDF, the grasp, the motions.
+  std::string urdf_path, gripper_links;
+  std::map<std::string, double> joint_positions;
+  app.add_option("--urdf", urdf_path, "the robot's URDF (the gripper's collision geometry)")->type_name("FILE");
+  app.add_option("--gripper-links", gripper_links, "links riding with the object; the first is F")
+      ->type_name("a,b,...");
+  app.add_option_function<std::vector<std::string>>(
+         "--gripper-joint",
+         [&](const std::vector<std::string>& v) {
+           for (const std::string& kv : v) {
+             const size_t eq = kv.find('=');
+             double q = 0;
+             if (eq == std::string::npos || !CLI::detail::lexical_cast(kv.substr(eq + 1), q) || !std::isfinite(q))
+               throw CLI::ValidationError("--gripper-joint", "expects NAME=VALUE (got '" + kv + "')");
+             joint_positions[kv.substr(0, eq)] = q;
+           }
+         },
+         "joint position at release [rad or m], repeatable")
+      ->type_name("NAME=VALUE");
+  app.add_option_function<std::string>(
+         "--grasp",
+         [&](const std::string& s) {
+           c.grasp = parsePose("--grasp", s);
+           c.has_grasp = true;
+         },
+         "pose of the gripper frame F in the object frame O (F's z: palm to fingertips)")
+      ->type_name("x,y,z,qx,qy,qz,qw");
+  app.add_flag("--keep-colliding", c.keep_colliding, "keep candidates the gripper blocks, marked");
+  app.add_option("--max-gripper-tilt-deg", c.max_gripper_tilt_deg, "F's z at most this far from down")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--gripper-min-clearance", c.gripper_min_clearance, "[m]")->check(kFinite)->capture_default_str();
+  app.add_option("--approach-distance", c.approach_distance, "[m]")->check(kFinite)->capture_default_str();
+  app.add_option("--approach-min-distance", c.approach_min_distance, "[m]")->check(kFinite)->capture_default_str();
+  app.add_option("--retreat-distance", c.retreat_distance, "[m]")->check(kFinite)->capture_default_str();
+  app.add_option("--retreat-min-distance", c.retreat_min_distance, "[m]")->check(kFinite)->capture_default_str();
+  // Preferences (ranking.h).
+  const std::map<std::string, RankOrder> orders = {
+      {"quality", RankOrder::kQuality}, {"lowest", RankOrder::kLowest}, {"nearest", RankOrder::kNearest}};
+  std::string order_name = "quality";
+  app.add_option("--rank-order", order_name, "quality | lowest | nearest (to --prefer-near)")
+      ->check(CLI::IsMember(orders))
+      ->capture_default_str();
+  app.add_option_function<std::string>(
+         "--prefer-near", [&](const std::string& s) { c.prefer_near = parseVector("--prefer-near", s); },
+         "point for --rank-order nearest (planning frame)")
+      ->type_name("x,y,z");
+  app.add_option("--min-edge-clearance", c.min_edge_clearance, "[m] from a drop-off of the area, 0 = off")
+      ->check(kFinite)
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);
@@ -401,6 +525,18 @@ int main(int argc, char** argv) {
 #ifndef PLACE_PLANNER_HAVE_VALIDATION
     if (verify_k > 0) throw InputError("--verify: built without Bullet (no validation library)");
 #endif
+    c.rank_order = orders.at(order_name);
+    if (!urdf_path.empty() || !gripper_links.empty()) {
+      if (urdf_path.empty() || gripper_links.empty())
+        throw InputError("--urdf and --gripper-links go together (the gripper needs both)");
+      if (!c.has_grasp) throw InputError("--urdf: the gripper needs --grasp (where it holds the object)");
+      try {
+        c.gripper = std::make_shared<GripperModel>(
+            gripperFromUrdfFile(urdf_path, CLI::detail::split(gripper_links, ','), joint_positions));
+      } catch (const std::invalid_argument& e) {
+        throw InputError(std::string("--urdf: ") + e.what());
+      }
+    }
     validateNamingFlags(c);
     c.backend = backends.at(backend_name);
     if (c.backend == BackendKind::kCuda) {

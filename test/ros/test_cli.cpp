@@ -392,6 +392,78 @@ TEST(PlacePlannerCli, JsonEscapesOddStrings) {
   rmdir(dir.c_str());
 }
 
+// A two-finger gripper of boxes, written for the test: palm frame F at the palm's inner face,
+// z towards the fingertips (5 cm), fingers closing along y.
+std::string boxGripperUrdf() {
+  static const std::string path = [] {
+    const std::string p = tempPath("gripper.urdf");
+    std::ofstream(p) << R"(<robot name="g">
+  <link name="palm"><collision><origin xyz="0 0 -0.01"/><geometry><box size="0.04 0.13 0.02"/></geometry></collision></link>
+  <link name="finger"><collision><origin xyz="0 0.004 0.025"/><geometry><box size="0.02 0.008 0.05"/></geometry></collision></link>
+  <joint name="finger_joint" type="prismatic"><parent link="palm"/><child link="finger"/><axis xyz="0 1 0"/>
+    <limit lower="0" upper="0.06" effort="1" velocity="1"/></joint>
+</robot>)";
+    return p;
+  }();
+  return path;
+}
+
+TEST(PlacePlannerCli, GripperFlagsGivePlaceLocationFieldsAndABlockingGraspNoStablePose) {
+  const std::string path = tempPath("gripper.json");
+  // The built-in cube (10 cm, base at z = 0) held from above: F 1 cm over its top, z down.
+  const std::vector<std::string> gripper = {"--urdf", boxGripperUrdf(), "--gripper-links", "palm,finger",
+                                            "--gripper-joint", "finger_joint=0.055"};
+  std::vector<std::string> args = cubeOnTable(gripper);
+  args.insert(args.end(), {"--grasp", "0,0,0.11,1,0,0,0", "--max-candidates", "3", "--json", path});
+  const CliRun r = cli(args);
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const json j = json::parse(readFile(path));
+  std::remove(path.c_str());
+  ASSERT_FALSE(j.at("candidates").empty());
+  for (const json& c : j.at("candidates")) {
+    const json& p = c.at("placement");
+    EXPECT_TRUE(p.at("checked").get<bool>());
+    EXPECT_EQ(p.at("blocked"), "");
+    ASSERT_TRUE(p.contains("gripper_pose")) << "a grasp gives the gripper's pose";
+    EXPECT_GE(p.at("gripper_clearance").get<double>(), 0.001);
+    // Straight approach from 10 cm above: pre-place = goal - 0.1 * direction (0, 0, -1).
+    EXPECT_TRUE(p.at("straight_approach").get<bool>());
+    EXPECT_NEAR(p.at("pre_place").at("position")[2].get<double>() - c.at("position")[2].get<double>(), 0.1, 1e-9);
+    EXPECT_GE(p.at("approach").at("free_distance").get<double>(), p.at("approach").at("min_distance").get<double>());
+    EXPECT_GE(p.at("retreat_in_gripper_frame").at("free_distance").get<double>(), 0.03);
+  }
+  // Fingertips 2 cm below the cube's base: every pose with the gripper from above collides.
+  std::vector<std::string> blocked = cubeOnTable(gripper);
+  blocked.insert(blocked.end(), {"--grasp", "0,0,0.03,1,0,0,0"});
+  const CliRun b = cli(blocked);
+  EXPECT_EQ(b.code, 1) << b.out << b.err;
+  EXPECT_TRUE(startsWith(b.last_line, "outcome: no_stable_pose")) << b.last_line;
+  EXPECT_TRUE(contains(b.err, "gripper")) << b.err;
+  // The gripper flags go together, and a bad link is named.
+  EXPECT_EQ(cli(cubeOnTable({"--urdf", boxGripperUrdf(), "--grasp", "0,0,0.11,1,0,0,0"})).code, 2);
+  const CliRun bad = cli(cubeOnTable({"--urdf", boxGripperUrdf(), "--gripper-links", "palm,thumb", "--grasp",
+                                      "0,0,0.11,1,0,0,0"}));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(contains(bad.err, "no link 'thumb'")) << bad.err;
+}
+
+TEST(PlacePlannerCli, MillimetreMeshIsBadInputNamingTheUnitAndLimitsAreFlags) {
+  const std::string mm = tempPath("cube_mm.ply");
+  saveMeshPly(transformed(scenes::byName("cube"), 1000.0 * Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()), mm);
+  const CliRun r = cli({"--object", mm, "--area", "builtin:table"});
+  std::remove(mm.c_str());
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_TRUE(contains(r.err, "max_object_size")) << r.err;
+  EXPECT_TRUE(contains(r.err, "millimetres")) << r.err;
+  const CliRun limits = cli(cubeOnTable({"--max-triangles", "1000", "--max-floor-points", "50", "--max-tree-nodes",
+                                         "100000", "--max-model-mb", "500", "--max-object-size", "1",
+                                         "--max-area-size", "10", "--budget-s", "20", "--rank-order", "lowest"}));
+  EXPECT_EQ(limits.code, 0) << limits.out << limits.err;
+  const CliRun bad = cli(cubeOnTable({"--max-floor-points", "0"}));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(contains(bad.err, "--max-floor-points")) << bad.err;
+}
+
 }  // namespace
 }  // namespace place_planner
 

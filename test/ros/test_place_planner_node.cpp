@@ -139,6 +139,32 @@ double angle(const geometry_msgs::Pose& a, const geometry_msgs::Pose& b) {
   return Eigen::AngleAxisd(fromMsg(a).rotation().transpose() * fromMsg(b).rotation()).angle();
 }
 
+// The same set of candidates in two answers (ties in Q may order them differently): each has a
+// twin within 1 mm and 0.01 rad with the same verdict, for at least 80 % of either answer (test
+// 2 says why not all).
+void expectSameCandidateSets(const std::vector<PlacementCandidate>& ref,
+                             const std::vector<PlacementCandidate>& got) {
+  for (const auto* pair : {&ref, &got}) {
+    const auto& from = *pair;
+    const auto& to = pair == &ref ? got : ref;
+    size_t matched = 0;
+    for (const auto& c : from) {
+      const PlacementCandidate* twin = nullptr;
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& d : to) {
+        const double dist = distance(c.pose.pose, d.pose.pose);
+        if (angle(c.pose.pose, d.pose.pose) < 0.01 && dist < best) best = dist, twin = &d;
+      }
+      if (twin && best < kSameAnswer && twin->stable == c.stable) {
+        EXPECT_NEAR(twin->quality, c.quality, kSameQuality);
+        ++matched;
+      }
+    }
+    EXPECT_GE(matched, static_cast<size_t>(0.8 * from.size())) << matched << " of " << from.size();
+    std::printf("[same set] %zu of %zu have a twin\n", matched, from.size());
+  }
+}
+
 // The answer of test 1 (meshes from the topics); computed once, shared with test 2.
 const Answer& topicAnswer() {
   static Answer answer;
@@ -244,24 +270,7 @@ TEST(PlacePlannerNode, InlineMeshesInTransformedFrameGiveSameAnswer) {
   // and may turn a perturbed release that balances on the edge of holding the other way: near
   // ties in Q then merge or rank differently, so up to 20 % may lack a twin (measured: 100 of
   // 120 match; a wrong transform matches none).
-  for (const auto* pair : {&ref, &got}) {
-    const auto& from = *pair;
-    const auto& to = pair == &ref ? got : ref;
-    size_t matched = 0;
-    for (const auto& c : from) {
-      const PlacementCandidate* twin = nullptr;
-      double best = std::numeric_limits<double>::infinity();
-      for (const auto& d : to) {
-        const double dist = distance(c.pose.pose, d.pose.pose);
-        if (angle(c.pose.pose, d.pose.pose) < 0.01 && dist < best) best = dist, twin = &d;
-      }
-      if (twin && best < kSameAnswer && twin->stable == c.stable) {
-        EXPECT_NEAR(twin->quality, c.quality, kSameQuality);
-        ++matched;
-      }
-    }
-    EXPECT_GE(matched, static_cast<size_t>(0.8 * from.size())) << matched << " of " << from.size();
-  }
+  expectSameCandidateSets(ref, got);
   // The best candidate is an equally good placement: a stable twin in the reference.
   bool best_has_twin = false;
   for (const auto& d : ref)
@@ -953,15 +962,14 @@ TEST(PlacePlannerManipulation, ShapeMsgsGoalGivesTheSameCandidatesAsPolygonMeshe
   goal.placement_area_shape_frame = "sensor";
   const Answer b = send(goal);
   ASSERT_EQ(b.result.error_code, Result::SUCCESS) << b.result.error_message;
-  ASSERT_EQ(b.result.candidates.size(), a.result.candidates.size());
-  for (size_t i = 0; i < a.result.candidates.size(); ++i) {
-    const auto& ca = a.result.candidates[i];
-    const auto& cb = b.result.candidates[i];
-    EXPECT_LT(distance(ca.pose.pose, cb.pose.pose), kSameAnswer) << "candidate " << i;
-    EXPECT_LT(angle(ca.pose.pose, cb.pose.pose), kSameAnswer) << "candidate " << i;
-    EXPECT_NEAR(ca.quality, cb.quality, kSameQuality) << "candidate " << i;
-    EXPECT_EQ(ca.stable, cb.stable) << "candidate " << i;
-  }
+  // The PolygonMesh carries float32 vertices, the shape float64, and the area came through a
+  // frame: near ties in Q may rank differently (test 2), so the sets are compared.
+  ASSERT_GT(a.result.candidates.size(), 5u);
+  EXPECT_NEAR(static_cast<double>(b.result.candidates.size()), static_cast<double>(a.result.candidates.size()),
+              0.1 * a.result.candidates.size() + 1);
+  expectSameCandidateSets(a.result.candidates, b.result.candidates);
+  EXPECT_TRUE(b.result.candidates.front().stable);
+  EXPECT_NEAR(b.result.candidates.front().quality, a.result.candidates.front().quality, kSameQuality);
 }
 
 TEST(PlacePlannerManipulation, ShapeTopicsAreUsedForGoalsWithoutMeshes) {
@@ -975,6 +983,10 @@ TEST(PlacePlannerManipulation, ShapeTopicsAreUsedForGoalsWithoutMeshes) {
   Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
   shift.translation().x() = 1.0;
   toMsg(mapped(testArea(), shift), &area);
+  // Latched, but the node must be connected before a goal can expect them.
+  for (int i = 0; i < 100 && (object_pub.getNumSubscribers() == 0 || area_pub.getNumSubscribers() == 0); ++i) {
+    ros::WallDuration(0.05).sleep();
+  }
   object_pub.publish(object);
   area_pub.publish(area);
   Answer a;

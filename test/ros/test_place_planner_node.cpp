@@ -950,15 +950,22 @@ TEST(PlacePlannerManipulation, FingersBelowTheBaseAreNoStablePoseNamingTheGrippe
 }
 
 TEST(PlacePlannerManipulation, ShapeMsgsGoalGivesTheSameCandidatesAsPolygonMeshes) {
+  // The area 0.7 m off in y, so that a node falling back on the topic meshes (test 1's scene)
+  // answers elsewhere.
+  Eigen::Isometry3d X_WA = Eigen::Isometry3d::Identity();
+  X_WA.translation().y() = 0.7;
+  const Mesh area_W = mapped(testArea(), X_WA);
   PlacePlanGoal goal = boxOnPlaneGoal();
+  goal.placement_area_mesh = meshMsg(area_W, "world");
   goal.max_candidates = 1000;
   const Answer a = send(goal);
   ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  ASSERT_GT(a.result.candidates.front().pose.pose.position.y, 0.5);
   // The same scene as shapes, the area's vertices in the sensor frame.
   goal.object_mesh = pcl_msgs::PolygonMesh();
   goal.placement_area_mesh = pcl_msgs::PolygonMesh();
   toMsg(testObject(), &goal.object_shape);
-  toMsg(mapped(testArea(), X_WS().inverse()), &goal.placement_area_shape);
+  toMsg(mapped(area_W, X_WS().inverse()), &goal.placement_area_shape);
   goal.placement_area_shape_frame = "sensor";
   const Answer b = send(goal);
   ASSERT_EQ(b.result.error_code, Result::SUCCESS) << b.result.error_message;

@@ -13,8 +13,9 @@ add_library(place_planner_ros STATIC
 target_include_directories(place_planner_ros PUBLIC
   ${PROJECT_SOURCE_DIR}/include ${CATKIN_DEVEL_PREFIX}/include ${catkin_INCLUDE_DIRS})
 # place_planner_validation (cmake/validation.cmake, defined after this file): verify_top_k.
-target_link_libraries(place_planner_ros PUBLIC place_planner_validation place_planner_core
-                      ${catkin_LIBRARIES})
+# place_planner_gripper (cmake/gripper.cmake): the gripper from the URDF, loaded at startup.
+target_link_libraries(place_planner_ros PUBLIC place_planner_validation place_planner_gripper
+                      place_planner_core ${catkin_LIBRARIES})
 target_compile_options(place_planner_ros PRIVATE ${PP_WARN})
 add_dependencies(place_planner_ros ${${PROJECT_NAME}_EXPORTED_TARGETS} ${catkin_EXPORTED_TARGETS})
 

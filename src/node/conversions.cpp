@@ -82,6 +82,39 @@ void fromMsg(const pcl_msgs::PolygonMesh& msg, const std::string& name,
   }
 }
 
+void fromMsg(const shape_msgs::Mesh& msg, const std::string& name,
+             std::vector<Eigen::Vector3d>* vertices, std::vector<std::vector<int>>* polygons) {
+  vertices->clear();
+  polygons->clear();
+  vertices->reserve(msg.vertices.size());
+  for (const auto& v : msg.vertices) vertices->push_back(fromMsg(v));
+  polygons->reserve(msg.triangles.size());
+  for (size_t t = 0; t < msg.triangles.size(); ++t) {
+    const auto& idx = msg.triangles[t].vertex_indices;
+    for (const uint32_t i : idx) {
+      if (i >= msg.vertices.size()) {
+        throw MeshError(name + ": triangle " + std::to_string(t) + " has vertex index " + std::to_string(i) +
+                        ", but the mesh has " + std::to_string(msg.vertices.size()) + " vertices");
+      }
+    }
+    polygons->push_back({static_cast<int>(idx[0]), static_cast<int>(idx[1]), static_cast<int>(idx[2])});
+  }
+}
+
+void toMsg(const Mesh& mesh, shape_msgs::Mesh* msg) {
+  msg->vertices.resize(mesh.vertices.size());
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) toMsg(mesh.vertices[i], &msg->vertices[i]);
+  msg->triangles.clear();
+  for (const auto& patch : mesh.patches) {
+    for (size_t k = 1; k + 1 < patch.size(); ++k) {
+      shape_msgs::MeshTriangle t;
+      t.vertex_indices = {static_cast<uint32_t>(patch[0]), static_cast<uint32_t>(patch[k]),
+                          static_cast<uint32_t>(patch[k + 1])};
+      msg->triangles.push_back(t);
+    }
+  }
+}
+
 void toMsg(const Mesh& mesh, const std::string& frame_id, pcl_msgs::PolygonMesh* msg) {
   msg->header.frame_id = frame_id;
   msg->cloud.header.frame_id = frame_id;
@@ -141,19 +174,37 @@ void toMsg(const Eigen::Vector3d& v, geometry_msgs::Vector3* msg) {
   msg->z = v.z();
 }
 
-void toMsg(const Candidate& c, const std::string& frame_id, const ros::Time& stamp,
-           const Eigen::Isometry3d* X_OG, PlacementCandidate* msg) {
+void toMsg(const Candidate& c, const std::string& frame_id, const std::string& gripper_frame,
+           const ros::Time& stamp, PlacementCandidate* msg) {
   msg->pose.header.frame_id = frame_id;
   msg->pose.header.stamp = stamp;
   toMsg(c.X_WO, &msg->pose.pose);
   // Without a grasp there is no gripper pose: left empty (all zero) rather than an identity
   // that a caller could mistake for one.
-  msg->has_gripper_pose = X_OG != nullptr;
+  msg->has_gripper_pose = c.has_gripper_pose;
   msg->gripper_pose = geometry_msgs::PoseStamped();
-  if (X_OG) {
+  if (c.has_gripper_pose) {
     msg->gripper_pose.header = msg->pose.header;
-    toMsg(Eigen::Isometry3d(c.X_WO * *X_OG), &msg->gripper_pose.pose);
+    toMsg(c.X_WF, &msg->gripper_pose.pose);
   }
+  // moveit_msgs/PlaceLocation's pre_place_approach and post_place_retreat.
+  const Placement& pl = c.placement;
+  msg->pre_place_pose.header = msg->pose.header;
+  toMsg(pl.pre_place_W, &msg->pre_place_pose.pose);
+  msg->straight_approach = pl.straight;
+  msg->approach_direction.header = msg->pose.header;
+  toMsg(pl.approach.direction, &msg->approach_direction.vector);
+  msg->approach_min_distance = pl.approach.min_distance;
+  msg->approach_desired_distance = pl.approach.desired_distance;
+  msg->approach_free_distance = pl.approach.free_distance;
+  msg->retreat_direction.header.frame_id = gripper_frame;
+  msg->retreat_direction.header.stamp = stamp;
+  toMsg(pl.retreat.direction, &msg->retreat_direction.vector);
+  msg->retreat_min_distance = pl.retreat.min_distance;
+  msg->retreat_desired_distance = pl.retreat.desired_distance;
+  msg->retreat_free_distance = pl.retreat.free_distance;
+  msg->gripper_clearance = pl.gripper_clearance;
+  msg->blocked = pl.blocked;
   msg->quality = c.quality;
   msg->stable = c.stable;
   msg->robust_share = c.robustness.share();

@@ -37,6 +37,21 @@ void setColour(Marker* m, float r, float g, float b, float a) {
   m->color.a = a;
 }
 
+constexpr float kGripperAlpha = 0.7f;      // the gripper over the translucent object
+
+Marker arrowMarker(const MarkerOptions& o, const char* ns, int id, const Eigen::Vector3d& from,
+                   const Eigen::Vector3d& to, float r, float g, float b) {
+  Marker arrow = makeMarker(o, ns, id, Marker::ARROW);
+  arrow.scale.x = 0.004;  // shaft diameter
+  arrow.scale.y = 0.009;  // head diameter
+  arrow.scale.z = 0.015;  // head length
+  setColour(&arrow, r, g, b, 1.0f);
+  arrow.points.resize(2);
+  toMsg(from, &arrow.points[0]);
+  toMsg(to, &arrow.points[1]);
+  return arrow;
+}
+
 // The mesh's triangles in its own frame; the marker pose places it.
 void addTriangles(const Mesh& mesh, Marker* m) {
   m->points.reserve(mesh.triangles.size() * 3);
@@ -115,8 +130,38 @@ visualization_msgs::MarkerArray buildMarkers(const Mesh& object_O, const Mesh& a
       array.markers.push_back(text);
     }
 
-    // Contacts of the best few only: the sphere model gives hundreds per pose.
+    // Contacts, motions and the gripper of the best few only: the sphere model gives hundreds
+    // of contacts per pose, and many grippers hide the scene.
     if (i >= std::max(1, o.text_count)) continue;
+    const Placement& pl = c.placement;
+    if (pl.checked && pl.approach.desired_distance > 0) {
+      // The object's centre of mass from the pre-place pose along the approach (to the goal
+      // when straight; to the first contact pose otherwise).
+      const Eigen::Vector3d from = pl.pre_place_W * object_O.properties.center_of_mass;
+      array.markers.push_back(arrowMarker(o, marker_ns::kApproach, i, from,
+                                          from + pl.approach.desired_distance * pl.approach.direction,
+                                          0.2f, 0.8f, 1.0f));
+    }
+    if (c.has_gripper_pose && o.gripper && !o.gripper->empty()) {
+      Marker gripper = makeMarker(o, marker_ns::kGripper, i, Marker::TRIANGLE_LIST);
+      toMsg(c.X_WF, &gripper.pose);
+      const bool blocked = !pl.blocked.empty();
+      setColour(&gripper, blocked ? 1.0f : 0.75f, blocked ? 0.2f : 0.75f, blocked ? 0.2f : 0.8f, kGripperAlpha);
+      gripper.points.reserve(o.gripper->triangles.size() * 3);
+      for (const auto& t : o.gripper->triangles) {
+        for (int k : t) {
+          geometry_msgs::Point p;
+          toMsg(o.gripper->vertices_F[k], &p);
+          gripper.points.push_back(p);
+        }
+      }
+      array.markers.push_back(gripper);
+    }
+    if (c.has_gripper_pose && pl.retreat.desired_distance > 0) {
+      const Eigen::Vector3d from = c.X_WF.translation();
+      const Eigen::Vector3d to = c.X_WF * (pl.retreat.desired_distance * pl.retreat.direction);
+      array.markers.push_back(arrowMarker(o, marker_ns::kRetreat, i, from, to, 1.0f, 0.4f, 1.0f));
+    }
     const size_t stride = std::max<size_t>(1, (c.contacts.size() + kMaxNormals - 1) / kMaxNormals);
     for (size_t k = 0; k < c.contacts.size(); ++k) {
       const ContactPoint& contact = c.contacts[k];

@@ -4,6 +4,12 @@
 #include <stdexcept>
 
 #include <ros/console.h>
+#include <ros/package.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "place_planner/gripper.h"
 
 #include <XmlRpcValue.h>
 
@@ -56,6 +62,37 @@ class ParamReader {
     }
   }
 
+  void read(const std::string& key, std::vector<std::string>* value) const {
+    XmlRpc::XmlRpcValue v;
+    if (!nh_.getParam(key, v)) return;
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeArray) fail(key, "must be a list of names");
+    value->clear();
+    for (int i = 0; i < v.size(); ++i) {
+      if (v[i].getType() != XmlRpc::XmlRpcValue::TypeString) fail(key, "must be a list of names");
+      value->push_back(static_cast<std::string>(v[i]));
+    }
+  }
+
+  void read(const std::string& key, std::map<std::string, double>* value) const {
+    XmlRpc::XmlRpcValue v;
+    if (!nh_.getParam(key, v)) return;
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeStruct) fail(key, "must be a map from joint name to a number");
+    value->clear();
+    for (auto& kv : v) {
+      double x;
+      if (!number(kv.second, &x) || !std::isfinite(x)) {
+        fail(key, "must be a map from joint name to a number ('" + kv.first + "' is not)");
+      }
+      (*value)[kv.first] = x;
+    }
+  }
+
+  // The value of a parameter named `key` found by searching up from the private namespace.
+  bool search(const std::string& key, std::string* value, std::string* where) const {
+    if (!nh_.searchParam(key, *where)) return false;
+    return nh_.getParam(*where, *value);
+  }
+
   [[noreturn]] void fail(const std::string& key, const std::string& why) const {
     throw std::invalid_argument("parameter " + fullName(key) + " " + why);
   }
@@ -83,7 +120,75 @@ BackendKind backendFromString(const std::string& s) {
   throw std::invalid_argument("backend = '" + s + "' is unknown (use auto, cpu or cuda)");
 }
 
+// package://pkg/rest through ROS's package path, file:// and absolute paths as they are,
+// relative ones against base_dir.
+std::string resolveMeshUri(const std::string& uri, const std::string& base_dir) {
+  if (uri.rfind("package://", 0) == 0) {
+    const std::string rest = uri.substr(10);
+    const size_t slash = rest.find('/');
+    const std::string pkg = rest.substr(0, slash);
+    const std::string dir = ros::package::getPath(pkg);
+    if (dir.empty()) throw std::invalid_argument("mesh '" + uri + "': package '" + pkg + "' not found");
+    return slash == std::string::npos ? dir : dir + rest.substr(slash);
+  }
+  if (uri.rfind("file://", 0) == 0) return uri.substr(7);
+  if (!uri.empty() && uri[0] != '/' && !base_dir.empty()) return base_dir + "/" + uri;
+  return uri;
+}
+
+// The gripper of NodeConfig's gripper parameters (doc/manipulation.md); null when no links.
+std::shared_ptr<const GripperModel> loadGripper(const NodeConfig& c, const ParamReader& r) {
+  if (c.gripper_links.empty()) return nullptr;
+  std::string xml, source, base_dir = c.gripper_mesh_dir;
+  if (!c.urdf_file.empty()) {
+    std::ifstream in(c.urdf_file);
+    if (!in) r.fail("urdf_file", "= '" + c.urdf_file + "' cannot be read");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    xml = ss.str();
+    source = "parameter " + r.fullName("urdf_file") + " ('" + c.urdf_file + "')";
+    const size_t slash = c.urdf_file.rfind('/');
+    if (base_dir.empty() && slash != std::string::npos) base_dir = c.urdf_file.substr(0, slash);
+  } else {
+    std::string where;
+    if (!r.search(c.robot_description_param, &xml, &where) || xml.empty()) {
+      r.fail("gripper_links", "is set, but there is no URDF: neither " + r.fullName("urdf_file") +
+                                  " nor a parameter '" + c.robot_description_param + "' (" +
+                                  r.fullName("robot_description_param") + ")");
+    }
+    source = "parameter " + where;
+  }
+  try {
+    auto g = std::make_shared<GripperModel>(gripperFromUrdf(
+        xml, c.gripper_links, c.gripper_joint_positions,
+        [&](const std::string& uri) { return resolveMeshUri(uri, base_dir); }));
+    if (g->empty()) r.fail("gripper_links", "name links without collision geometry in the URDF of " + source);
+    ROS_INFO("place_planner: gripper of %zu links (%zu triangles, frame '%s') from the URDF of %s",
+             c.gripper_links.size(), g->triangles.size(), c.gripper_links.front().c_str(), source.c_str());
+    return g;
+  } catch (const std::invalid_argument& e) {
+    if (std::string(e.what()).rfind("parameter ", 0) == 0) throw;
+    r.fail("gripper_links", "cannot be loaded from the URDF of " + source + ": " + e.what());
+  }
+}
+
 }  // namespace
+
+RankOrder rankOrderFromName(const std::string& name) {
+  if (name == "quality") return RankOrder::kQuality;
+  if (name == "lowest") return RankOrder::kLowest;
+  if (name == "nearest") return RankOrder::kNearest;
+  throw std::invalid_argument("rank_order = '" + name + "' is unknown (use quality, lowest or nearest)");
+}
+
+const char* rankOrderName(RankOrder order) {
+  switch (order) {
+    case RankOrder::kQuality: return "quality";
+    case RankOrder::kLowest: return "lowest";
+    case RankOrder::kNearest: return "nearest";
+  }
+  return "quality";
+}
 
 NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   const ParamReader r(nh);
@@ -155,7 +260,33 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("backend", &backend);
   r.read("region_min", &p.region_min);
   r.read("region_max", &p.region_max);
+  // Bounded work (issue 10).
+  r.read("max_triangles", &p.max_triangles);
+  r.read("max_floor_points", &p.max_floor_points);
+  double max_tree_nodes = static_cast<double>(p.max_tree_nodes);  // a long; YAML ints are 32 bit
+  r.read("max_tree_nodes", &max_tree_nodes);
+  if (!(std::isfinite(max_tree_nodes) && max_tree_nodes >= 100 && max_tree_nodes <= 9e15 &&
+        max_tree_nodes == std::floor(max_tree_nodes))) {
+    r.fail("max_tree_nodes", "is out of range (a whole number >= 100)");
+  }
+  p.max_tree_nodes = static_cast<long>(max_tree_nodes);
+  r.read("max_model_mb", &p.max_model_mb);
+  r.read("max_object_size", &p.max_object_size);
+  r.read("max_area_size", &p.max_area_size);
+  // Manipulation (issue 11). has_grasp and grasp come with each goal.
+  r.read("max_gripper_tilt_deg", &p.max_gripper_tilt_deg);
+  r.read("gripper_min_clearance", &p.gripper_min_clearance);
+  r.read("keep_colliding", &p.keep_colliding);
+  r.read("approach_distance", &p.approach_distance);
+  r.read("approach_min_distance", &p.approach_min_distance);
+  r.read("retreat_distance", &p.retreat_distance);
+  r.read("retreat_min_distance", &p.retreat_min_distance);
+  std::string rank_order = rankOrderName(p.rank_order);
+  r.read("rank_order", &rank_order);
+  r.read("prefer_near", &p.prefer_near);
+  r.read("min_edge_clearance", &p.min_edge_clearance);
   try {
+    p.rank_order = rankOrderFromName(rank_order);
     p.orientation = orientationModeFromString(orientation);
     p.backend = backendFromString(backend);
     validate(p);  // "friction = -0.1 is out of range (...)"
@@ -165,6 +296,15 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
     if (what.rfind("orientation_mode", 0) == 0) what.replace(0, 16, "orientation");
     throw std::invalid_argument("parameter " + r.fullName("") + "/" + what);
   }
+  r.read("robot_description_param", &c.robot_description_param);
+  r.read("urdf_file", &c.urdf_file);
+  r.read("gripper_links", &c.gripper_links);
+  r.read("gripper_joint_positions", &c.gripper_joint_positions);
+  r.read("gripper_mesh_dir", &c.gripper_mesh_dir);
+  r.read("object_shape_frame", &c.object_shape_frame);
+  r.read("placement_area_shape_frame", &c.placement_area_shape_frame);
+  if (c.robot_description_param.empty()) r.fail("robot_description_param", "must not be empty");
+  p.gripper = loadGripper(c, r);
   return c;
 }
 

@@ -12,6 +12,7 @@
 
 #include "place_planner/ros/conversions.h"
 #include "place_planner/ros/markers.h"
+#include "place_planner/work_limits.h"
 #include "place_planner/validation/physics_validator.h"
 
 namespace place_planner {
@@ -46,11 +47,26 @@ PlacePlannerNode::PlacePlannerNode(const ros::NodeHandle& nh, const ros::NodeHan
       "object_mesh", 1, [this](const pcl_msgs::PolygonMeshConstPtr& m) {
         std::lock_guard<std::mutex> lock(mesh_mutex_);
         latest_object_ = m;
+        latest_object_shape_.reset();
       });
   area_sub_ = nh_.subscribe<pcl_msgs::PolygonMesh>(
       "placement_area_mesh", 1, [this](const pcl_msgs::PolygonMeshConstPtr& m) {
         std::lock_guard<std::mutex> lock(mesh_mutex_);
         latest_area_ = m;
+        latest_area_shape_.reset();
+      });
+  // shape_msgs/Mesh (MoveIt's collision objects) beside the PolygonMesh: the newest of the two wins.
+  object_shape_sub_ = nh_.subscribe<shape_msgs::Mesh>(
+      "object_shape", 1, [this](const shape_msgs::MeshConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mesh_mutex_);
+        latest_object_shape_ = m;
+        latest_object_.reset();
+      });
+  area_shape_sub_ = nh_.subscribe<shape_msgs::Mesh>(
+      "placement_area_shape", 1, [this](const shape_msgs::MeshConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mesh_mutex_);
+        latest_area_shape_ = m;
+        latest_area_.reset();
       });
   marker_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
   candidates_pub_ = pnh_.advertise<geometry_msgs::PoseArray>("candidates", 1, true);
@@ -164,6 +180,7 @@ void PlacePlannerNode::serve(GoalHandle goal) {
     options.stamp = answer.stamp;
     options.max_candidates = config_.marker_candidates;
     options.text_count = config_.marker_text_count;
+    options.gripper = config_.planner.gripper.get();
     marker_pub_.publish(buildMarkers(answer.prepared.object_O, answer.prepared.area_W, answer.plan, options));
     geometry_msgs::PoseArray poses;
     poses.header.frame_id = config_.planning_frame;
@@ -222,10 +239,19 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
     std::lock_guard<std::mutex> lock(mesh_mutex_);
     topics.object = latest_object_;
     topics.area = latest_area_;
+    topics.object_shape = latest_object_shape_;
+    topics.area_shape = latest_area_shape_;
   }
   topics.object_topic = object_sub_.getTopic();
   topics.area_topic = area_sub_.getTopic();
-  answer->prepared = prepareGoal(goal, topics, config_, [this](const std::string& f) { return lookup(f); });
+  topics.object_shape_topic = object_shape_sub_.getTopic();
+  topics.area_shape_topic = area_shape_sub_.getTopic();
+  int objects = 0;
+  Mesh added = areaAdditions(goal, placed_, &objects);
+  answer->prepared = prepareGoal(goal, topics, config_, [this](const std::string& f) { return lookup(f); }, &added);
+  // The goal is valid: its reset/add stands, whatever the plan comes to.
+  placed_.added_W = std::move(added);
+  placed_.count = objects;
   const PreparedGoal& prepared = answer->prepared;
 
   {
@@ -238,12 +264,24 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   try {
     plan = planner_.plan(prepared.object_O, prepared.area_W, prepared.config,
                          [this](const Progress& p) { return onProgress(p); });
+  } catch (const LimitError& e) {
+    // A mesh beyond the bounded-work limits (max_object_size, max_model_mb, ...): the input's.
+    throw GoalError(Result::INVALID_MESH, e.what());
   } catch (const std::exception& e) {
     // Whatever the planner throws for a goal prepareGoal accepted is the planner's failure.
     throw std::runtime_error(std::string("planner failed: ") + e.what());
   }
   answer->planned = true;
-  for (const auto& w : plan.warnings) ROS_WARN("place_planner: %s", w.c_str());
+  placed_.has_last_plan = true;
+  placed_.last_object_O = prepared.object_O;
+  placed_.last_X_WO.clear();
+  for (const Candidate& c : plan.candidates) placed_.last_X_WO.push_back(c.X_WO);
+  // Warnings about the gripper explain a NO_STABLE_POSE: they go into its message.
+  std::string gripper_warnings;
+  for (const auto& w : plan.warnings) {
+    ROS_WARN("place_planner: %s", w.c_str());
+    if (w.find("gripper") != std::string::npos) gripper_warnings += w + "; ";
+  }
 
   // Physics check of the best K stable candidates, in what is left of the budget; not for a
   // cancelled goal, and a cancel stops it starting further checks.
@@ -268,11 +306,14 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   Result& result = answer->result;
   answer->stamp = ros::Time::now();
   result.candidates.resize(plan.candidates.size());
+  const std::string gripper_frame = config_.planner.gripper ? config_.planner.gripper->links.front() : "";
   for (size_t i = 0; i < plan.candidates.size(); ++i) {
-    toMsg(plan.candidates[i], config_.planning_frame, answer->stamp,
-          prepared.has_grasp ? &prepared.X_OG : nullptr, &result.candidates[i]);
+    toMsg(plan.candidates[i], config_.planning_frame, gripper_frame, answer->stamp, &result.candidates[i]);
   }
   result.floor_points_evaluated = plan.stats.floor_points_done;
+  result.gripper_rejected = plan.stats.gripper_rejected;
+  result.gripper_tilt_rejected = plan.stats.gripper_tilt_rejected;
+  result.objects_in_area = placed_.count;
   result.partial = false;
   const int n_stable = plan.stableCount();
   std::ostringstream summary;
@@ -280,6 +321,10 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
           << plan.stats.floor_points_done << " of " << plan.stats.floor_points_total
           << " floor points in " << (ros::WallTime::now() - plan_start_).toSec() << " s"
           << physics_summary;
+  if (prepared.config.has_grasp) {
+    summary << "; gripper: " << plan.stats.gripper_rejected << " candidates blocked, "
+            << plan.stats.gripper_tilt_rejected << " poses tilted over max_gripper_tilt_deg";
+  }
   std::ostringstream budget;
   budget << "time budget of " << prepared.config.time_budget_ms / 1000.0 << " s used up";
   // PlanResult::outcome() decides; the codes keep their numbers.
@@ -315,7 +360,7 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
       break;
     case PlanOutcome::kNoStable:
       result.error_code = Result::NO_STABLE_POSE;
-      result.error_message = "no stable pose: " + summary.str();
+      result.error_message = "no stable pose: " + gripper_warnings + summary.str();
       answer->terminal = Terminal::kAborted;
       break;
     case PlanOutcome::kStable:

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "place_planner/ros/conversions.h"
+#include "place_planner/scenes.h"
 
 namespace place_planner {
 namespace {
@@ -47,17 +48,53 @@ Mesh mappedBy(Mesh mesh, const Eigen::Isometry3d& X) {
 bool overrides(bool use, double value) { return use || (value != 0.0 && !std::isnan(value)); }
 bool overrides(bool use, int value) { return use || value != 0; }
 
-// The mesh a goal plans with: its own, or the latest from the topic.
-const pcl_msgs::PolygonMesh& chooseMesh(const pcl_msgs::PolygonMesh& in_goal,
-                                        const pcl_msgs::PolygonMeshConstPtr& from_topic,
-                                        const std::string& what, const std::string& field,
-                                        const std::string& topic) {
-  if (!in_goal.polygons.empty()) return in_goal;
-  if (!from_topic) {
-    throw GoalError(Result::NO_MESH, what + ": the goal's " + field +
-                                         " is empty and nothing was received on " + topic);
+// Where a goal's mesh comes from: a PolygonMesh or a shape_msgs/Mesh, its vertices in `frame`.
+struct MeshSource {
+  const pcl_msgs::PolygonMesh* polygon = nullptr;
+  const shape_msgs::Mesh* shape = nullptr;
+  std::string frame;
+  std::string name;  // "object mesh", "object shape", ... for error messages
+};
+
+// The mesh a goal plans with: its own PolygonMesh, its own shape, or the latest from a topic.
+MeshSource chooseMesh(const pcl_msgs::PolygonMesh& in_goal, const shape_msgs::Mesh& shape_in_goal,
+                      const std::string& shape_frame_in_goal,
+                      const pcl_msgs::PolygonMeshConstPtr& from_topic,
+                      const shape_msgs::MeshConstPtr& shape_from_topic, const std::string& shape_frame_param,
+                      const std::string& what, const std::string& field, const std::string& shape_field,
+                      const std::string& topic, const std::string& shape_topic) {
+  MeshSource s;
+  const std::string shape_name = what.substr(0, what.size() - 4) + "shape";  // "object mesh" -> "object shape"
+  if (!in_goal.polygons.empty()) {
+    s.polygon = &in_goal;
+    s.frame = in_goal.header.frame_id;
+    s.name = what;
+  } else if (!shape_in_goal.triangles.empty()) {
+    s.shape = &shape_in_goal;
+    s.frame = shape_frame_in_goal;
+    s.name = shape_name;
+  } else if (from_topic) {
+    s.polygon = from_topic.get();
+    s.frame = from_topic->header.frame_id;
+    s.name = what;
+  } else if (shape_from_topic) {
+    s.shape = shape_from_topic.get();
+    s.frame = shape_frame_param;
+    s.name = shape_name;
+  } else {
+    throw GoalError(Result::NO_MESH, what + ": the goal's " + field + " and " + shape_field +
+                                         " are empty and nothing was received on " + topic + " or " +
+                                         shape_topic);
   }
-  return *from_topic;
+  return s;
+}
+
+void read(const MeshSource& s, std::vector<Eigen::Vector3d>* vertices, std::vector<std::vector<int>>* polygons) {
+  if (s.polygon) {
+    fromMsg(*s.polygon, s.name, vertices, polygons);
+  } else {
+    fromMsg(*s.shape, s.name, vertices, polygons);
+  }
 }
 
 }  // namespace
@@ -77,8 +114,28 @@ const char* errorCodeName(uint8_t code) {
   }
 }
 
+Mesh areaAdditions(const PlacePlanGoal& goal, const PlacedObjects& placed, int* count) {
+  Mesh added = goal.reset_area ? Mesh() : placed.added_W;
+  *count = goal.reset_area ? 0 : placed.count;
+  if (!goal.add_to_area) return added;
+  if (!placed.has_last_plan) {
+    throw GoalError(Result::INVALID_GOAL, "goal: add_to_area is set, but no goal was planned before to take "
+                                          "its candidate add_candidate from");
+  }
+  const int n = static_cast<int>(placed.last_X_WO.size());
+  if (goal.add_candidate < 0 || goal.add_candidate >= n) {
+    throw GoalError(Result::INVALID_GOAL, "goal: add_candidate = " + std::to_string(goal.add_candidate) +
+                                              " is out of range (the previous plan has " + std::to_string(n) +
+                                              " candidates" + (n > 0 ? ": 0 .. " + std::to_string(n - 1) : "") + ")");
+  }
+  const Eigen::Isometry3d& X = placed.last_X_WO[goal.add_candidate];
+  const Mesh object_W = transformed(placed.last_object_O, X.rotation(), X.translation());
+  *count += 1;
+  return added.vertices.empty() ? object_W : scenes::merge({added, object_W}, "objects added to the area");
+}
+
 PreparedGoal prepareGoal(const PlacePlanGoal& goal, const TopicMeshes& topics,
-                         const NodeConfig& params, const FrameLookup& lookup) {
+                         const NodeConfig& params, const FrameLookup& lookup, const Mesh* added_W) {
   const std::string& W = params.planning_frame;
   // X_WF of `frame`; `what` names the field that needed it.
   const auto X_W = [&](const std::string& frame, const std::string& what) -> Eigen::Isometry3d {
@@ -92,31 +149,36 @@ PreparedGoal prepareGoal(const PlacePlanGoal& goal, const TopicMeshes& topics,
   };
 
   PreparedGoal out;
-  const pcl_msgs::PolygonMesh& object =
-      chooseMesh(goal.object_mesh, topics.object, "object mesh", "object_mesh", topics.object_topic);
-  const pcl_msgs::PolygonMesh& area =
-      chooseMesh(goal.placement_area_mesh, topics.area, "placement area mesh",
-                 "placement_area_mesh", topics.area_topic);
+  const MeshSource object =
+      chooseMesh(goal.object_mesh, goal.object_shape, goal.object_shape_frame, topics.object,
+                 topics.object_shape, params.object_shape_frame, "object mesh", "object_mesh",
+                 "object_shape", topics.object_topic, topics.object_shape_topic);
+  const MeshSource area =
+      chooseMesh(goal.placement_area_mesh, goal.placement_area_shape, goal.placement_area_shape_frame,
+                 topics.area, topics.area_shape, params.placement_area_shape_frame,
+                 "placement area mesh", "placement_area_mesh", "placement_area_shape", topics.area_topic,
+                 topics.area_shape_topic);
 
   // Frames. X_WO: where the object's mesh frame is now.
   const Eigen::Isometry3d X_WO =
       X_W(goal.object_pose.header.frame_id, "object_pose") * poseFromGoal(goal.object_pose.pose, "object_pose.pose");
-  const Eigen::Isometry3d X_WA = X_W(area.header.frame_id, "placement area mesh");
-  // Object vertices are in header.frame_id M when set, else in O.
+  const Eigen::Isometry3d X_WA = X_W(area.frame, area.name);
+  // Object vertices are in the mesh's frame M when set, else in O.
   const Eigen::Isometry3d X_OM =
-      object.header.frame_id.empty()
-          ? Eigen::Isometry3d::Identity()
-          : Eigen::Isometry3d(X_WO.inverse() * X_W(object.header.frame_id, "object mesh"));
+      object.frame.empty() ? Eigen::Isometry3d::Identity()
+                           : Eigen::Isometry3d(X_WO.inverse() * X_W(object.frame, object.name));
 
   // Validated in the frame they came in (so an index or coordinate in a message names the element
   // as sent), then mapped.
   std::vector<Eigen::Vector3d> vertices;
   std::vector<std::vector<int>> polygons;
   try {
-    fromMsg(object, "object mesh", &vertices, &polygons);
-    out.object_O = mappedBy(buildMesh(vertices, polygons, "object mesh"), X_OM);
-    fromMsg(area, "placement area mesh", &vertices, &polygons);
-    out.area_W = mappedBy(buildMesh(vertices, polygons, "placement area mesh"), X_WA);
+    read(object, &vertices, &polygons);
+    out.object_O = mappedBy(buildMesh(vertices, polygons, object.name), X_OM);
+    read(area, &vertices, &polygons);
+    out.area_W = mappedBy(buildMesh(vertices, polygons, area.name), X_WA);
+    // Objects placed before (add_to_area) become part of the area.
+    if (added_W && !added_W->vertices.empty()) out.area_W = scenes::merge({out.area_W, *added_W}, area.name);
   } catch (const MeshError& e) {
     throw GoalError(Result::INVALID_MESH, e.what());
   }
@@ -157,8 +219,17 @@ PreparedGoal prepareGoal(const PlacePlanGoal& goal, const TopicMeshes& topics,
     throw GoalError(Result::INVALID_GOAL, "goal: verify_top_k = " + std::to_string(goal.verify_top_k) +
                                               " is out of range (0 .. 100; 0 or < 0 = off)");
   }
+  // Manipulation (doc/manipulation.md): ranking, edge clearance, blocked candidates.
+  if (overrides(goal.use_min_edge_clearance, goal.min_edge_clearance)) c.min_edge_clearance = goal.min_edge_clearance;
+  if (goal.use_keep_colliding || goal.keep_colliding) c.keep_colliding = goal.keep_colliding;
+  if (!goal.prefer_near.header.frame_id.empty() || fromMsg(goal.prefer_near.point).norm() != 0.0) {
+    const Eigen::Vector3d p = fromMsg(goal.prefer_near.point);
+    if (!p.allFinite()) throw GoalError(Result::INVALID_GOAL, "goal: prefer_near is not finite");
+    c.prefer_near = X_W(goal.prefer_near.header.frame_id, "prefer_near") * p;
+  }
   try {
     if (!goal.orientation_mode.empty()) c.orientation = orientationModeFromString(goal.orientation_mode);
+    if (!goal.rank_order.empty()) c.rank_order = rankOrderFromName(goal.rank_order);
     validate(c);  // names the field: "friction = -1 is out of range (...)"
   } catch (const std::invalid_argument& e) {
     throw GoalError(Result::INVALID_GOAL, std::string("goal: ") + e.what());
@@ -189,6 +260,9 @@ PreparedGoal prepareGoal(const PlacePlanGoal& goal, const TopicMeshes& topics,
   if (goal.has_grasp) {
     out.has_grasp = true;
     out.X_OG = poseFromGoal(goal.grasp, "grasp");
+    // The core checks the node's gripper (params.planner.gripper, null: none) at this grasp.
+    c.has_grasp = true;
+    c.grasp = out.X_OG;
   }
   return out;
 }

@@ -5,9 +5,11 @@
 #include <actionlib/client/action_client.h>
 #include <actionlib/client/simple_action_client.h>
 #include <gtest/gtest.h>
+#include <ros/package.h>
 #include <ros/ros.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_ros/static_transform_broadcaster.h>
+#include <shape_msgs/Mesh.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <atomic>
@@ -15,6 +17,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <set>
 
@@ -47,7 +50,7 @@ constexpr double kCancelLatency = 0.5;
 // Feedback is promised every 100 ms; allow scheduling jitter on a loaded 2-core CI machine.
 constexpr double kFeedbackGap = 0.15;
 // sizeof(PlannerConfig) when the YAML was last brought in line with it (x86-64, g++ 12).
-constexpr size_t kPlannerConfigSize = 304;
+constexpr size_t kPlannerConfigSize = 592;
 
 // The scene of the quick goals: a box on a 0.4 x 0.3 m plane at z = 0.
 Mesh testArea() { return scenes::plane(0.4, 0.3); }
@@ -134,6 +137,32 @@ double distance(const geometry_msgs::Pose& a, const geometry_msgs::Pose& b) {
 }
 double angle(const geometry_msgs::Pose& a, const geometry_msgs::Pose& b) {
   return Eigen::AngleAxisd(fromMsg(a).rotation().transpose() * fromMsg(b).rotation()).angle();
+}
+
+// The same set of candidates in two answers (ties in Q may order them differently): each has a
+// twin within 1 mm and 0.01 rad with the same verdict, for at least 80 % of either answer (test
+// 2 says why not all).
+void expectSameCandidateSets(const std::vector<PlacementCandidate>& ref,
+                             const std::vector<PlacementCandidate>& got) {
+  for (const auto* pair : {&ref, &got}) {
+    const auto& from = *pair;
+    const auto& to = pair == &ref ? got : ref;
+    size_t matched = 0;
+    for (const auto& c : from) {
+      const PlacementCandidate* twin = nullptr;
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& d : to) {
+        const double dist = distance(c.pose.pose, d.pose.pose);
+        if (angle(c.pose.pose, d.pose.pose) < 0.01 && dist < best) best = dist, twin = &d;
+      }
+      if (twin && best < kSameAnswer && twin->stable == c.stable) {
+        EXPECT_NEAR(twin->quality, c.quality, kSameQuality);
+        ++matched;
+      }
+    }
+    EXPECT_GE(matched, static_cast<size_t>(0.8 * from.size())) << matched << " of " << from.size();
+    std::printf("[same set] %zu of %zu have a twin\n", matched, from.size());
+  }
 }
 
 // The answer of test 1 (meshes from the topics); computed once, shared with test 2.
@@ -241,24 +270,7 @@ TEST(PlacePlannerNode, InlineMeshesInTransformedFrameGiveSameAnswer) {
   // and may turn a perturbed release that balances on the edge of holding the other way: near
   // ties in Q then merge or rank differently, so up to 20 % may lack a twin (measured: 100 of
   // 120 match; a wrong transform matches none).
-  for (const auto* pair : {&ref, &got}) {
-    const auto& from = *pair;
-    const auto& to = pair == &ref ? got : ref;
-    size_t matched = 0;
-    for (const auto& c : from) {
-      const PlacementCandidate* twin = nullptr;
-      double best = std::numeric_limits<double>::infinity();
-      for (const auto& d : to) {
-        const double dist = distance(c.pose.pose, d.pose.pose);
-        if (angle(c.pose.pose, d.pose.pose) < 0.01 && dist < best) best = dist, twin = &d;
-      }
-      if (twin && best < kSameAnswer && twin->stable == c.stable) {
-        EXPECT_NEAR(twin->quality, c.quality, kSameQuality);
-        ++matched;
-      }
-    }
-    EXPECT_GE(matched, static_cast<size_t>(0.8 * from.size())) << matched << " of " << from.size();
-  }
+  expectSameCandidateSets(ref, got);
   // The best candidate is an equally good placement: a stable twin in the reference.
   bool best_has_twin = false;
   for (const auto& d : ref)
@@ -538,6 +550,36 @@ TEST(PlacePlannerNode, PlannerExceptionIsInternalErrorAndNodeServesOn) {
 }
 
 // ---------------------------------------------------------------- 6
+// The marker batch the node publishes after answering `goal` (the answer in *answer); an
+// empty batch when none came within 2.5 s.
+visualization_msgs::MarkerArray markersOf(const PlacePlanGoal& goal, Answer* answer) {
+  std::mutex mutex;
+  std::vector<visualization_msgs::MarkerArray> batches;
+  ros::NodeHandle nh;
+  ros::Subscriber sub = nh.subscribe<visualization_msgs::MarkerArray>(
+      "/place_planner/markers", 10, [&](const visualization_msgs::MarkerArrayConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        batches.push_back(*m);
+      });
+  // Latched: the previous goal's batch arrives first.
+  ros::WallDuration(0.5).sleep();
+  size_t before;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    before = batches.size();
+  }
+  *answer = send(goal);
+  for (int i = 0; i < 50; ++i) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (batches.size() > before) return batches.back();
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  ADD_FAILURE() << "no markers after the goal";
+  return {};
+}
+
 TEST(PlacePlannerNode, FeedbackDuringLongPlanAndDocumentedMarkers) {
   FeedbackLog log;
   sendWithFeedback(longGoal(), &log);
@@ -560,36 +602,12 @@ TEST(PlacePlannerNode, FeedbackDuringLongPlanAndDocumentedMarkers) {
   EXPECT_GT(items.back().second.floor_points_done, 0);
 
   // Markers of a completed goal: one batch, DELETEALL first, every documented namespace.
-  std::mutex mutex;
-  std::vector<visualization_msgs::MarkerArray> batches;
-  ros::NodeHandle nh;
-  ros::Subscriber sub = nh.subscribe<visualization_msgs::MarkerArray>(
-      "/place_planner/markers", 10, [&](const visualization_msgs::MarkerArrayConstPtr& m) {
-        std::lock_guard<std::mutex> lock(mutex);
-        batches.push_back(*m);
-      });
-  // Latched: the previous (cancelled) goal's batch arrives first.
-  ros::WallDuration(0.5).sleep();
-  size_t before;
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    before = batches.size();
-  }
   PlacePlanGoal goal = quickGoal();
   goal.object_mesh = meshMsg(testObject(), "");
   goal.placement_area_mesh = meshMsg(testArea(), "world");
-  const Answer a = send(goal);
+  Answer a;
+  const visualization_msgs::MarkerArray batch = markersOf(goal, &a);
   ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
-  for (int i = 0; i < 50; ++i) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (batches.size() > before) break;
-    }
-    ros::WallDuration(0.05).sleep();
-  }
-  std::lock_guard<std::mutex> lock(mutex);
-  ASSERT_GT(batches.size(), before) << "no markers after the goal";
-  const auto& batch = batches.back();
   ASSERT_FALSE(batch.markers.empty());
   EXPECT_EQ(batch.markers.front().action, visualization_msgs::Marker::DELETEALL);
   std::set<std::string> ns;
@@ -600,10 +618,10 @@ TEST(PlacePlannerNode, FeedbackDuringLongPlanAndDocumentedMarkers) {
   for (const char* expected :
        {marker_ns::kPlacementArea, marker_ns::kCandidates, marker_ns::kContacts,
         marker_ns::kContactNormals, marker_ns::kFloorPoints, marker_ns::kBestPath,
-        marker_ns::kQuality}) {
+        marker_ns::kQuality, marker_ns::kApproach}) {
     EXPECT_EQ(ns.count(expected), 1u) << "namespace " << expected << " missing";
   }
-  EXPECT_EQ(ns.size(), 7u);
+  EXPECT_EQ(ns.size(), 8u) << "without a grasp: no gripper, no retreat";
   // One object per candidate (up to marker_candidates = 10), coloured by Q.
   int objects = 0;
   for (const auto& m : batch.markers) objects += m.ns == marker_ns::kCandidates;
@@ -779,6 +797,275 @@ TEST(PlacePlannerNode, VerifyTopKChecksTheBestTwoStableCandidates) {
   }
 }
 
+// ---------------------------------------------------------------- manipulation (issue 11)
+// The node runs with the test gripper (test/gripper/test_gripper.urdf through robot_description,
+// place_planner_node.test): palm, fingers 2.2 cm off the middle, a camera.
+
+// The box of these tests: 4 x 4 x 8 cm, its frame O at the centre of its base.
+constexpr double kTallBoxHeight = 0.08;
+Mesh tallBox() { return scenes::box(0.04, 0.04, kTallBoxHeight, Eigen::Vector3d(0, 0, kTallBoxHeight / 2)); }
+// Two such boxes that do not overlap have centres at least one box width (4 cm) apart; the
+// planner's contact tolerance allows them to touch.
+constexpr double kBoxesApart = 0.04 - 2e-3;
+
+// Held from above: F (the palm) at height z in O, F's z (palm -> fingertips) pointing down.
+Eigen::Isometry3d graspFromAbove(double z) {
+  Eigen::Isometry3d X_OF = Eigen::Isometry3d::Identity();
+  X_OF.translation() = Eigen::Vector3d(0, 0, z);
+  X_OF.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  return X_OF;
+}
+
+// Square pegs 1 cm wide, 10 cm tall, 7 cm apart on a floor (test_gripper.cpp): the box fits
+// between them, the fingers around it (6 cm across) only in the middle of a cell.
+Mesh pegField() {
+  std::vector<Mesh> parts = {scenes::box(0.42, 0.42, 0.01, Eigen::Vector3d(0, 0, -0.005))};
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j) parts.push_back(scenes::box(0.01, 0.01, 0.1, Eigen::Vector3d(0.07 * i, 0.07 * j, 0.05)));
+  return scenes::merge(parts, "pegs");
+}
+
+PlacePlanGoal tallBoxGoal(const Mesh& area) {
+  PlacePlanGoal goal;
+  goal.object_pose.header.frame_id = "world";
+  goal.object_pose.pose.position.z = 0.5;
+  goal.object_pose.pose.orientation.w = 1.0;
+  goal.object_mesh = meshMsg(tallBox(), "");
+  goal.placement_area_mesh = meshMsg(area, "world");
+  goal.use_max_candidates = true;
+  goal.max_candidates = 30;
+  return goal;
+}
+
+PlacePlanGoal heldGoal(const Mesh& area, double grasp_z) {
+  PlacePlanGoal goal = tallBoxGoal(area);
+  goal.has_grasp = true;
+  toMsg(graspFromAbove(grasp_z), &goal.grasp);
+  return goal;
+}
+
+Eigen::Vector3d vec(const geometry_msgs::Vector3& v) { return fromMsg(v); }
+Eigen::Vector3d pointOf(const geometry_msgs::Point& p) { return fromMsg(p); }
+
+TEST(PlacePlannerManipulation, AmongPegsTheGripperFitsAndEveryPlaceLocationFieldIsFilled) {
+  const Eigen::Isometry3d X_OF = graspFromAbove(0.09);  // palm 1 cm over the top
+  Answer a;
+  const visualization_msgs::MarkerArray batch = markersOf(heldGoal(pegField(), 0.09), &a);
+  ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  ASSERT_FALSE(a.result.candidates.empty());
+  // The gripper reached the planner: it blocked some candidates (fingers in a peg) ...
+  EXPECT_GT(a.result.gripper_rejected, 0);
+  std::printf("[gripper] %zu candidates, %d blocked by the gripper, %d tilted, %.3f s\n",
+              a.result.candidates.size(), a.result.gripper_rejected, a.result.gripper_tilt_rejected,
+              a.result.planning_time);
+  int straight = 0;
+  for (const auto& c : a.result.candidates) {
+    // ... and none of those answered is blocked (keep_colliding is off).
+    EXPECT_TRUE(c.blocked.empty()) << c.blocked;
+    EXPECT_GE(c.gripper_clearance, 0.001 - 1e-9) << "closer than gripper_min_clearance";
+    ASSERT_TRUE(c.has_gripper_pose);
+    geometry_msgs::Pose expected;
+    toMsg(Eigen::Isometry3d(fromMsg(c.pose.pose) * X_OF), &expected);
+    EXPECT_LT(distance(c.gripper_pose.pose, expected), kExact);
+    EXPECT_LT(angle(c.gripper_pose.pose, expected), kExact);
+    // Approach: in W, along gravity (the default approach), the parameters' distances.
+    EXPECT_EQ(c.approach_direction.header.frame_id, "world");
+    EXPECT_LT((vec(c.approach_direction.vector) - Eigen::Vector3d(0, 0, -1)).norm(), 1e-9);
+    EXPECT_DOUBLE_EQ(c.approach_min_distance, 0.03);
+    EXPECT_DOUBLE_EQ(c.approach_desired_distance, 0.10);
+    EXPECT_GE(c.approach_free_distance, c.approach_min_distance);
+    EXPECT_LE(c.approach_free_distance, c.approach_desired_distance + 1e-9);
+    // Retreat: in F (frame_id the first gripper link), back along -z of F.
+    EXPECT_EQ(c.retreat_direction.header.frame_id, "palm");
+    EXPECT_LT((vec(c.retreat_direction.vector) - Eigen::Vector3d(0, 0, -1)).norm(), 1e-9);
+    EXPECT_DOUBLE_EQ(c.retreat_min_distance, 0.03);
+    EXPECT_DOUBLE_EQ(c.retreat_desired_distance, 0.10);
+    EXPECT_GE(c.retreat_free_distance, c.retreat_min_distance);
+    EXPECT_LE(c.retreat_free_distance, c.retreat_desired_distance + 1e-9);
+    EXPECT_EQ(c.pre_place_pose.header.frame_id, "world");
+    if (!c.straight_approach) continue;
+    ++straight;
+    // Straight: the pre-place pose is the goal pose, desired_distance back along the approach.
+    const Eigen::Vector3d expected_pre = pointOf(c.pose.pose.position) -
+                                         c.approach_desired_distance * vec(c.approach_direction.vector);
+    EXPECT_LT((pointOf(c.pre_place_pose.pose.position) - expected_pre).norm(), 1e-6);
+    EXPECT_LT(angle(c.pre_place_pose.pose, c.pose.pose), 1e-6);
+  }
+  EXPECT_GT(straight, 0) << "from above between pegs, some approach is straight";
+
+  // Markers: the gripper's triangles at the best few gripper poses, approach and retreat arrows.
+  int grippers = 0, approaches = 0, retreats = 0;
+  for (const auto& m : batch.markers) {
+    if (m.ns == marker_ns::kGripper) {
+      ++grippers;
+      ASSERT_LT(m.id, static_cast<int>(a.result.candidates.size()));
+      EXPECT_EQ(m.type, visualization_msgs::Marker::TRIANGLE_LIST);
+      EXPECT_GE(m.points.size(), 3u * 12 * 3) << "palm and fingers are boxes of 12 triangles";
+      EXPECT_EQ(m.points.size() % 3, 0u);
+      EXPECT_LT(distance(m.pose, a.result.candidates[m.id].gripper_pose.pose), 1e-6);
+    } else if (m.ns == marker_ns::kApproach) {
+      ++approaches;
+      ASSERT_EQ(m.points.size(), 2u);
+      EXPECT_NEAR((pointOf(m.points[1]) - pointOf(m.points[0])).norm(), 0.10, 1e-6);
+    } else if (m.ns == marker_ns::kRetreat) {
+      ++retreats;
+      ASSERT_EQ(m.points.size(), 2u);
+      const auto& g = a.result.candidates[m.id].gripper_pose.pose.position;
+      EXPECT_LT((pointOf(m.points[0]) - pointOf(g)).norm(), 1e-6);
+      // F's -z is up here: the gripper backs off upwards.
+      EXPECT_NEAR(m.points[1].z - m.points[0].z, 0.10, 1e-3);
+    }
+  }
+  const int best_few = std::min<int>(3, a.result.candidates.size());  // marker_text_count
+  EXPECT_EQ(grippers, best_few);
+  EXPECT_EQ(approaches, best_few);
+  EXPECT_EQ(retreats, best_few);
+}
+
+TEST(PlacePlannerManipulation, FingersBelowTheBaseAreNoStablePoseNamingTheGripper) {
+  // F 3 cm over the base, fingers 5 cm long: their tips 2 cm below the table top.
+  PlacePlanGoal goal = heldGoal(testArea(), 0.03);
+  Answer a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::NO_STABLE_POSE) << a.result.error_message;
+  EXPECT_EQ(a.state, actionlib::SimpleClientGoalState::ABORTED);
+  EXPECT_EQ(a.result.error_message.rfind("no stable pose: ", 0), 0u) << a.result.error_message;
+  EXPECT_NE(a.result.error_message.find("gripper blocks every stable pose"), std::string::npos)
+      << a.result.error_message;
+  EXPECT_GT(a.result.gripper_rejected, 0);
+  for (const auto& c : a.result.candidates) EXPECT_FALSE(c.stable);
+  // Held 1 cm over the top instead, the same box stands on the table: the gripper was the reason.
+  toMsg(graspFromAbove(0.09), &goal.grasp);
+  a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  // keep_colliding (a goal override): the blocked candidates come back, marked, not stable.
+  goal = heldGoal(testArea(), 0.03);
+  goal.keep_colliding = true;
+  a = send(goal);
+  EXPECT_EQ(a.result.error_code, Result::NO_STABLE_POSE) << a.result.error_message;
+  ASSERT_FALSE(a.result.candidates.empty());
+  for (const auto& c : a.result.candidates) {
+    EXPECT_FALSE(c.stable);
+    EXPECT_FALSE(c.blocked.empty());
+  }
+}
+
+TEST(PlacePlannerManipulation, ShapeMsgsGoalGivesTheSameCandidatesAsPolygonMeshes) {
+  // The area 0.7 m off in y, so that a node falling back on the topic meshes (test 1's scene)
+  // answers elsewhere.
+  Eigen::Isometry3d X_WA = Eigen::Isometry3d::Identity();
+  X_WA.translation().y() = 0.7;
+  const Mesh area_W = mapped(testArea(), X_WA);
+  PlacePlanGoal goal = boxOnPlaneGoal();
+  goal.placement_area_mesh = meshMsg(area_W, "world");
+  goal.max_candidates = 1000;
+  const Answer a = send(goal);
+  ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  ASSERT_GT(a.result.candidates.front().pose.pose.position.y, 0.5);
+  // The same scene as shapes, the area's vertices in the sensor frame.
+  goal.object_mesh = pcl_msgs::PolygonMesh();
+  goal.placement_area_mesh = pcl_msgs::PolygonMesh();
+  toMsg(testObject(), &goal.object_shape);
+  toMsg(mapped(area_W, X_WS().inverse()), &goal.placement_area_shape);
+  goal.placement_area_shape_frame = "sensor";
+  const Answer b = send(goal);
+  ASSERT_EQ(b.result.error_code, Result::SUCCESS) << b.result.error_message;
+  // The PolygonMesh carries float32 vertices, the shape float64, and the area came through a
+  // frame: near ties in Q may rank differently (test 2), so the sets are compared.
+  ASSERT_GT(a.result.candidates.size(), 5u);
+  EXPECT_NEAR(static_cast<double>(b.result.candidates.size()), static_cast<double>(a.result.candidates.size()),
+              0.1 * a.result.candidates.size() + 1);
+  expectSameCandidateSets(a.result.candidates, b.result.candidates);
+  EXPECT_TRUE(b.result.candidates.front().stable);
+  EXPECT_NEAR(b.result.candidates.front().quality, a.result.candidates.front().quality, kSameQuality);
+}
+
+TEST(PlacePlannerManipulation, ShapeTopicsAreUsedForGoalsWithoutMeshes) {
+  // The area as a shape on placement_area_shape (frame: the parameter, "" = W), 1 m off in x: the
+  // answer must lie on it, so a node still using the PolygonMesh topic (test 1's) fails.
+  ros::NodeHandle nh;
+  static ros::Publisher object_pub = nh.advertise<shape_msgs::Mesh>("object_shape", 1, true);
+  static ros::Publisher area_pub = nh.advertise<shape_msgs::Mesh>("placement_area_shape", 1, true);
+  shape_msgs::Mesh object, area;
+  toMsg(testObject(), &object);
+  Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
+  shift.translation().x() = 1.0;
+  toMsg(mapped(testArea(), shift), &area);
+  // Latched, but the node must be connected before a goal can expect them.
+  for (int i = 0; i < 100 && (object_pub.getNumSubscribers() == 0 || area_pub.getNumSubscribers() == 0); ++i) {
+    ros::WallDuration(0.05).sleep();
+  }
+  object_pub.publish(object);
+  area_pub.publish(area);
+  Answer a;
+  for (int i = 0; i < 50; ++i) {  // until the node has them
+    a = send(quickGoal());
+    if (!a.result.candidates.empty() && a.result.candidates.front().pose.pose.position.x > 0.75) break;
+    ros::WallDuration(0.1).sleep();
+  }
+  ASSERT_EQ(a.result.error_code, Result::SUCCESS) << a.result.error_message;
+  for (const auto& c : a.result.candidates) {
+    for (const auto& p : c.contact_points) {
+      EXPECT_GE(p.x, 0.8 - kOnSurface);
+      EXPECT_LE(p.x, 1.2 + kOnSurface);
+      EXPECT_NEAR(p.z, 0.0, kOnSurface);
+    }
+  }
+}
+
+// Centre of the tall box at a candidate's pose.
+Eigen::Vector3d tallBoxCentre(const PlacementCandidate& c) {
+  return fromMsg(c.pose.pose) * Eigen::Vector3d(0, 0, kTallBoxHeight / 2);
+}
+
+TEST(PlacePlannerManipulation, AddToAreaPlacesTheNextBoxBesideTheFirstAndResetFreesItsSpot) {
+  PlacePlanGoal goal = tallBoxGoal(testArea());
+  goal.use_max_candidates = true;
+  goal.max_candidates = 10;
+  goal.reset_area = true;  // whatever earlier tests left
+  const Answer first = send(goal);
+  ASSERT_EQ(first.result.error_code, Result::SUCCESS) << first.result.error_message;
+  EXPECT_EQ(first.result.objects_in_area, 0);
+  ASSERT_FALSE(first.result.candidates.empty());
+  const PlacementCandidate& c0 = first.result.candidates.front();
+  const Eigen::Vector3d centre0 = tallBoxCentre(c0);
+
+  // The first box placed at candidate 0: nothing new overlaps it.
+  goal.reset_area = false;
+  goal.add_to_area = true;
+  goal.add_candidate = 0;
+  const Answer second = send(goal);
+  ASSERT_EQ(second.result.error_code, Result::SUCCESS) << second.result.error_message;
+  EXPECT_EQ(second.result.objects_in_area, 1);
+  ASSERT_FALSE(second.result.candidates.empty());
+  for (const auto& c : second.result.candidates) {
+    EXPECT_GE((tallBoxCentre(c) - centre0).norm(), kBoxesApart)
+        << "a candidate at " << tallBoxCentre(c).transpose() << " overlaps the box at " << centre0.transpose();
+  }
+  // Stacked on it or beside it; the first plan's best spot is taken.
+  EXPECT_GT(distance(second.result.candidates.front().pose.pose, c0.pose.pose), 0.01);
+
+  // A bad index: INVALID_GOAL naming the field, and nothing changes.
+  goal.add_candidate = 1000;
+  Answer bad = send(goal);
+  EXPECT_EQ(bad.result.error_code, Result::INVALID_GOAL);
+  EXPECT_NE(bad.result.error_message.find("add_candidate = 1000"), std::string::npos) << bad.result.error_message;
+  goal.add_to_area = false;
+  const Answer again = send(goal);
+  ASSERT_EQ(again.result.error_code, Result::SUCCESS) << again.result.error_message;
+  EXPECT_EQ(again.result.objects_in_area, 1);
+  for (const auto& c : again.result.candidates) EXPECT_GE((tallBoxCentre(c) - centre0).norm(), kBoxesApart);
+
+  // reset_area: the area is the table again, and the first plan's answer comes back.
+  goal.reset_area = true;
+  const Answer reset = send(goal);
+  ASSERT_EQ(reset.result.error_code, Result::SUCCESS) << reset.result.error_message;
+  EXPECT_EQ(reset.result.objects_in_area, 0);
+  ASSERT_FALSE(reset.result.candidates.empty());
+  EXPECT_LT(distance(reset.result.candidates.front().pose.pose, c0.pose.pose), kSameAnswer);
+  std::printf("[add_to_area] first at (%.3f, %.3f), next best at %.3f m from it\n", centre0.x(), centre0.y(),
+              (tallBoxCentre(second.result.candidates.front()) - centre0).norm());
+}
+
 // ---------------------------------------------------------------- parameters
 TEST(PlacePlannerParams, OutOfRangeAndWrongTypeAreNamed) {
   ros::NodeHandle nh("/params_test");
@@ -860,7 +1147,12 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
         "max_candidates", "threads", "max_local_optimisation_steps", "min_support_width", "min_tipping_angle_deg",
         "min_quality", "merge_distance", "merge_angle_deg", "backend", "region_min", "region_max",
         "planning_frame", "tf_timeout", "feedback_period", "marker_candidates",
-        "marker_text_count"}) {
+        "marker_text_count", "max_triangles", "max_floor_points", "max_tree_nodes", "max_model_mb",
+        "max_object_size", "max_area_size", "max_gripper_tilt_deg", "gripper_min_clearance",
+        "keep_colliding", "approach_distance", "approach_min_distance", "retreat_distance",
+        "retreat_min_distance", "rank_order", "prefer_near", "min_edge_clearance",
+        "robot_description_param", "urdf_file", "gripper_links", "gripper_joint_positions",
+        "gripper_mesh_dir", "object_shape_frame", "placement_area_shape_frame"}) {
     EXPECT_TRUE(nh.hasParam(name)) << name << " missing from config/place_planner.yaml";
   }
   const PlannerConfig d;
@@ -894,9 +1186,72 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
   EXPECT_EQ(y.backend, d.backend);
   EXPECT_EQ(y.region_min, d.region_min);
   EXPECT_EQ(y.region_max, d.region_max);
+  EXPECT_EQ(y.max_triangles, d.max_triangles);
+  EXPECT_EQ(y.max_floor_points, d.max_floor_points);
+  EXPECT_EQ(y.max_tree_nodes, d.max_tree_nodes);
+  EXPECT_EQ(y.max_model_mb, d.max_model_mb);
+  EXPECT_EQ(y.max_object_size, d.max_object_size);
+  EXPECT_EQ(y.max_area_size, d.max_area_size);
+  EXPECT_EQ(y.max_gripper_tilt_deg, d.max_gripper_tilt_deg);
+  EXPECT_EQ(y.gripper_min_clearance, d.gripper_min_clearance);
+  EXPECT_EQ(y.keep_colliding, d.keep_colliding);
+  EXPECT_EQ(y.approach_distance, d.approach_distance);
+  EXPECT_EQ(y.approach_min_distance, d.approach_min_distance);
+  EXPECT_EQ(y.retreat_distance, d.retreat_distance);
+  EXPECT_EQ(y.retreat_min_distance, d.retreat_min_distance);
+  EXPECT_EQ(y.rank_order, d.rank_order);
+  EXPECT_EQ(y.prefer_near, d.prefer_near);
+  EXPECT_EQ(y.min_edge_clearance, d.min_edge_clearance);
+  // has_grasp, grasp: per goal; gripper: loaded from gripper_links (the .test file sets them).
+  EXPECT_EQ(y.has_grasp, d.has_grasp);
   // The struct's size: a new field changes it; then list it above and in the YAML.
   EXPECT_EQ(sizeof(PlannerConfig), kPlannerConfigSize)
       << "PlannerConfig changed: mirror the new field in config/place_planner.yaml and params.cpp";
+}
+
+// The gripper parameters: the URDF from a file or from robot_description, links named in errors.
+TEST(PlacePlannerParams, GripperIsLoadedAtStartupAndBadLinksAreNamed) {
+  const std::string urdf = ros::package::getPath("place_planner") + "/test/gripper/test_gripper.urdf";
+  ros::NodeHandle nh("/gripper_params_test");
+  nh.setParam("gripper_links", std::vector<std::string>{"palm", "left_finger", "right_finger"});
+  nh.setParam("urdf_file", urdf);
+  std::map<std::string, double> joints{{"left_finger_joint", 0.03}};
+  nh.setParam("gripper_joint_positions", joints);
+  NodeConfig c = loadNodeConfig(nh);
+  ASSERT_TRUE(c.planner.gripper);
+  EXPECT_EQ(c.planner.gripper->links, (std::vector<std::string>{"palm", "left_finger", "right_finger"}));
+  EXPECT_EQ(c.planner.gripper->triangles.size(), 36u) << "three boxes";
+  // Below the palm (z > 0) only the fingers: the left one's outer face at the opening 0.03
+  // plus its 8 mm width.
+  double max_y = -1;
+  for (const auto& v : c.planner.gripper->vertices_F)
+    if (v.z() > 1e-6) max_y = std::max(max_y, v.y());
+  EXPECT_NEAR(max_y, 0.038, 1e-9);
+  const auto fails = [&](const std::string& what) {
+    try {
+      loadNodeConfig(nh);
+      ADD_FAILURE() << "accepted; expected an error naming " << what;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("/gripper_params_test/"), std::string::npos) << e.what();
+    }
+  };
+  nh.setParam("gripper_links", std::vector<std::string>{"palm", "thumb"});
+  fails("thumb");
+  nh.setParam("gripper_links", std::vector<std::string>{"palm"});
+  nh.setParam("urdf_file", std::string("/no/such/gripper.urdf"));
+  fails("/no/such/gripper.urdf");
+  // From the parameter robot_description_param names (searched up from the namespace).
+  nh.setParam("urdf_file", std::string(""));
+  nh.setParam("robot_description_param", std::string("no_such_description"));
+  fails("no_such_description");
+  nh.setParam("robot_description_param", std::string("robot_description"));  // /robot_description
+  c = loadNodeConfig(nh);
+  ASSERT_TRUE(c.planner.gripper);
+  EXPECT_EQ(c.planner.gripper->triangles.size(), 12u) << "the palm";
+  nh.setParam("gripper_joint_positions", std::string("open"));
+  fails("gripper_joint_positions");
+  nh.deleteParam("");
 }
 
 TEST(PlacePlannerParams, NodeRefusesToStartWithBadParameter) {
@@ -911,6 +1266,18 @@ TEST(PlacePlannerParams, NodeRefusesToStartWithBadParameter) {
   const int status = pclose(pipe);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << output;
   EXPECT_NE(output.find("/bad_place_planner/max_rotations"), std::string::npos) << output;
+  // An unknown gripper link (the URDF from /robot_description): named, exit 1.
+  ros::NodeHandle nh("/bad_gripper_planner");
+  nh.setParam("gripper_links", std::vector<std::string>{"palm", "thumb"});
+  FILE* pipe2 = popen(("timeout 20 " + std::string(PP_NODE_BINARY) + " __name:=bad_gripper_planner 2>&1").c_str(), "r");
+  ASSERT_NE(pipe2, nullptr);
+  output.clear();
+  while (fgets(buf, sizeof buf, pipe2)) output += buf;
+  const int status2 = pclose(pipe2);
+  nh.deleteParam("");
+  EXPECT_TRUE(WIFEXITED(status2) && WEXITSTATUS(status2) == 1) << output;
+  EXPECT_NE(output.find("/bad_gripper_planner/gripper_links"), std::string::npos) << output;
+  EXPECT_NE(output.find("thumb"), std::string::npos) << output;
 }
 
 }  // namespace

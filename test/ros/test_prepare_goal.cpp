@@ -344,6 +344,172 @@ TEST(PrepareGoal, EmptyMeshTakesTheTopicsOrIsNoMesh) {
   EXPECT_NEAR(p.area_W.properties.bounds_max.z(), 0.0, kFloat32);
 }
 
+// ---------------------------------------------------------------- shape_msgs/Mesh (issue 11)
+TEST(ShapeMsgs, MeshConvertsVertexForVertexAndNamesABadIndex) {
+  shape_msgs::Mesh m;
+  toMsg(object(), &m);
+  // A box: 8 vertices, its 6 quads fanned into 12 triangles.
+  ASSERT_EQ(m.vertices.size(), 8u);
+  ASSERT_EQ(m.triangles.size(), 12u);
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::vector<int>> polygons;
+  fromMsg(m, "object shape", &v, &polygons);
+  ASSERT_EQ(v.size(), 8u);
+  for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], object().vertices[i]);  // float64 kept
+  ASSERT_EQ(polygons.size(), 12u);
+  for (size_t t = 0; t < polygons.size(); ++t) {
+    ASSERT_EQ(polygons[t].size(), 3u);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(polygons[t][k], static_cast<int>(m.triangles[t].vertex_indices[k]));
+  }
+  EXPECT_NEAR(buildMesh(v, polygons, "object shape").properties.surface_area, object().properties.surface_area, kExact);
+  m.triangles[3].vertex_indices[1] = 12;
+  try {
+    fromMsg(m, "object shape", &v, &polygons);
+    ADD_FAILURE() << "index 12 of 8 vertices accepted";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("object shape: triangle 3 has vertex index 12, but the mesh has 8 vertices"),
+              std::string::npos) << e.what();
+  }
+}
+
+TEST(ShapeMsgs, GoalShapesAreUsedWhenThePolygonMeshesAreEmpty) {
+  PlacePlanGoal g = goal();
+  g.object_mesh = pcl_msgs::PolygonMesh();
+  g.placement_area_mesh = pcl_msgs::PolygonMesh();
+  toMsg(object(), &g.object_shape);  // frame "" = O
+  toMsg(mapped(area(), X_WS().inverse()), &g.placement_area_shape);
+  g.placement_area_shape_frame = "sensor";
+  const PreparedGoal p = prepare(g);
+  ASSERT_EQ(p.object_O.vertices.size(), object().vertices.size());
+  for (size_t i = 0; i < p.object_O.vertices.size(); ++i) EXPECT_LT((p.object_O.vertices[i] - object().vertices[i]).norm(), kExact);
+  ASSERT_EQ(p.area_W.vertices.size(), area().vertices.size());
+  for (size_t i = 0; i < p.area_W.vertices.size(); ++i) EXPECT_LT((p.area_W.vertices[i] - area().vertices[i]).norm(), 1e-12 + 1e-9);
+  // A bad index in the goal's shape is INVALID_MESH naming the shape.
+  g.placement_area_shape.triangles[1].vertex_indices[0] = 99;
+  GoalError e = errorOf(g);
+  EXPECT_EQ(e.code, Result::INVALID_MESH);
+  EXPECT_TRUE(mentions(e, "placement area shape: triangle 1 has vertex index 99")) << e.what();
+  // Neither in the goal nor on a topic: NO_MESH naming both fields and both topics.
+  g.placement_area_shape = shape_msgs::Mesh();
+  e = errorOf(g);
+  EXPECT_EQ(e.code, Result::NO_MESH);
+  EXPECT_TRUE(mentions(e, "placement_area_shape")) << e.what();
+  EXPECT_TRUE(mentions(e, "placement_area_mesh")) << e.what();
+  // The topic's shape, in the frame the parameter names.
+  TopicMeshes topics;
+  auto shape = boost::make_shared<shape_msgs::Mesh>();
+  toMsg(mapped(scenes::plane(1.0, 0.5), X_WS().inverse()), shape.get());
+  topics.area_shape = shape;
+  NodeConfig np = params();
+  np.placement_area_shape_frame = "sensor";
+  const PreparedGoal q = prepareGoal(g, topics, np, frames());
+  EXPECT_NEAR(q.area_W.properties.bounds_max.x(), 0.5, 1e-9);
+  EXPECT_NEAR(q.area_W.properties.bounds_max.y(), 0.25, 1e-9);
+}
+
+// ---------------------------------------------------------------- manipulation fields (issue 11)
+TEST(PrepareGoal, ManipulationFieldsReachTheConfig) {
+  PlacePlanGoal g = goal();
+  NodeConfig np = params();
+  np.planner.min_edge_clearance = 0.02;
+  np.planner.rank_order = RankOrder::kLowest;
+  // Unset: the parameters.
+  PreparedGoal p = prepare(g, np);
+  EXPECT_EQ(p.config.rank_order, RankOrder::kLowest);
+  EXPECT_EQ(p.config.min_edge_clearance, 0.02);
+  EXPECT_FALSE(p.config.keep_colliding);
+  EXPECT_FALSE(p.config.has_grasp);
+  // Set: the goal's, prefer_near brought into W, the grasp into the config.
+  g.rank_order = "nearest";
+  g.prefer_near.header.frame_id = "sensor";
+  g.prefer_near.point.x = 0.1;
+  g.use_min_edge_clearance = true;
+  g.min_edge_clearance = 0.0;
+  g.keep_colliding = true;
+  g.has_grasp = true;
+  Eigen::Isometry3d X_OF = Eigen::Isometry3d::Identity();
+  X_OF.translate(Eigen::Vector3d(0, 0, 0.09));
+  X_OF.rotate(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+  toMsg(X_OF, &g.grasp);
+  p = prepare(g, np);
+  EXPECT_EQ(p.config.rank_order, RankOrder::kNearest);
+  EXPECT_LT((p.config.prefer_near - X_WS() * Eigen::Vector3d(0.1, 0, 0)).norm(), kExact);
+  EXPECT_EQ(p.config.min_edge_clearance, 0.0);
+  EXPECT_TRUE(p.config.keep_colliding);
+  EXPECT_TRUE(p.config.has_grasp);
+  EXPECT_LT((p.config.grasp.matrix() - X_OF.matrix()).norm(), 1e-12);
+  // Bad values name the field.
+  g.rank_order = "tallest";
+  GoalError e = errorOf(g);
+  EXPECT_EQ(e.code, Result::INVALID_GOAL);
+  EXPECT_TRUE(mentions(e, "rank_order")) << e.what();
+  EXPECT_TRUE(mentions(e, "tallest")) << e.what();
+  g.rank_order = "";
+  g.min_edge_clearance = -0.01;
+  e = errorOf(g);
+  EXPECT_EQ(e.code, Result::INVALID_GOAL);
+  EXPECT_TRUE(mentions(e, "min_edge_clearance")) << e.what();
+}
+
+// ---------------------------------------------------------------- objects one after another
+TEST(AreaAdditions, AddMergesThePreviousObjectAtItsCandidateAndResetDropsIt) {
+  PlacedObjects placed;
+  PlacePlanGoal g = goal();
+  int count = -1;
+  EXPECT_TRUE(areaAdditions(g, placed, &count).vertices.empty());
+  EXPECT_EQ(count, 0);
+  // No previous plan: INVALID_GOAL naming add_to_area.
+  g.add_to_area = true;
+  try {
+    areaAdditions(g, placed, &count);
+    ADD_FAILURE() << "add_to_area without a previous plan accepted";
+  } catch (const GoalError& e) {
+    EXPECT_EQ(e.code, Result::INVALID_GOAL);
+    EXPECT_TRUE(mentions(e, "add_to_area")) << e.what();
+  }
+  placed.has_last_plan = true;
+  placed.last_object_O = object();
+  Eigen::Isometry3d X0 = Eigen::Isometry3d::Identity(), X1 = Eigen::Isometry3d::Identity();
+  X0.translation() = Eigen::Vector3d(0.1, 0.05, 0.02);
+  X1.translation() = Eigen::Vector3d(-0.1, 0, 0.02);
+  X1.rotate(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+  placed.last_X_WO = {X0, X1};
+  g.add_candidate = 2;
+  try {
+    areaAdditions(g, placed, &count);
+    ADD_FAILURE() << "add_candidate 2 of 2 accepted";
+  } catch (const GoalError& e) {
+    EXPECT_EQ(e.code, Result::INVALID_GOAL);
+    EXPECT_TRUE(mentions(e, "add_candidate = 2 is out of range (the previous plan has 2 candidates: 0 .. 1)")) << e.what();
+  }
+  g.add_candidate = 1;
+  Mesh added = areaAdditions(g, placed, &count);
+  EXPECT_EQ(count, 1);
+  ASSERT_EQ(added.vertices.size(), 8u);
+  for (size_t i = 0; i < 8; ++i) EXPECT_LT((added.vertices[i] - X1 * object().vertices[i]).norm(), kExact);
+  // A second one is merged beside the first.
+  placed.added_W = added;
+  placed.count = 1;
+  g.add_candidate = 0;
+  added = areaAdditions(g, placed, &count);
+  EXPECT_EQ(count, 2);
+  EXPECT_EQ(added.vertices.size(), 16u);
+  EXPECT_NEAR(added.properties.surface_area, 2 * object().properties.surface_area, 1e-9);
+  // reset_area first: only the new one.
+  g.reset_area = true;
+  added = areaAdditions(g, placed, &count);
+  EXPECT_EQ(count, 1);
+  EXPECT_EQ(added.vertices.size(), 8u);
+  g.add_to_area = false;
+  EXPECT_TRUE(areaAdditions(g, placed, &count).vertices.empty());
+  EXPECT_EQ(count, 0);
+  // prepareGoal merges them into the area.
+  g.reset_area = false;
+  const PreparedGoal p = prepareGoal(goal(), TopicMeshes(), params(), frames(), &placed.added_W);
+  EXPECT_EQ(p.area_W.vertices.size(), area().vertices.size() + 8);
+  EXPECT_NEAR(p.area_W.properties.bounds_max.z(), 0.04, kFloat32);
+}
+
 TEST(ErrorCodeName, NamesEveryCode) {
   EXPECT_STREQ(errorCodeName(Result::SUCCESS), "SUCCESS");
   EXPECT_STREQ(errorCodeName(Result::PREEMPTED), "PREEMPTED");

@@ -10,6 +10,7 @@
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Vector3.h>
 #include <pcl_msgs/PolygonMesh.h>
+#include <shape_msgs/Mesh.h>
 #include <ros/time.h>
 
 #include "place_planner/PlacePlanFeedback.h"
@@ -27,6 +28,17 @@ namespace place_planner {
 void fromMsg(const pcl_msgs::PolygonMesh& msg, const std::string& name,
              std::vector<Eigen::Vector3d>* vertices, std::vector<std::vector<int>>* polygons);
 
+// shape_msgs/Mesh (what MoveIt's collision objects hold: float64 vertices, triangles) ->
+// vertex positions and triangles, ready for buildMesh(), which checks NaN/Inf. A triangle index
+// past the vertices throws MeshError naming the mesh, the triangle and the index ("object
+// shape: triangle 3 has vertex index 12, but the mesh has 8 vertices").
+void fromMsg(const shape_msgs::Mesh& msg, const std::string& name,
+             std::vector<Eigen::Vector3d>* vertices, std::vector<std::vector<int>>* polygons);
+
+// Mesh patches -> shape_msgs/Mesh: each patch fanned into triangles from its first vertex
+// (patches are convex, mesh.h).
+void toMsg(const Mesh& mesh, shape_msgs::Mesh* msg);
+
 // Mesh patches -> PolygonMesh (float32 x, y, z cloud, one Vertices per patch), in frame_id.
 void toMsg(const Mesh& mesh, const std::string& frame_id, pcl_msgs::PolygonMesh* msg);
 
@@ -39,11 +51,13 @@ Eigen::Vector3d fromMsg(const geometry_msgs::Vector3& msg);
 void toMsg(const Eigen::Vector3d& v, geometry_msgs::Point* msg);
 void toMsg(const Eigen::Vector3d& v, geometry_msgs::Vector3* msg);
 
-// One candidate, all in frame_id (the planning frame W). X_OG: the grasp (gripper pose in the
-// object frame) (optional); when given, gripper_pose = X_WO * X_OG and has_gripper_pose =
-// true; otherwise has_gripper_pose = false and gripper_pose is all zero (frame_id empty).
-void toMsg(const Candidate& candidate, const std::string& frame_id, const ros::Time& stamp,
-           const Eigen::Isometry3d* X_OG, PlacementCandidate* msg);
+// One candidate, all in frame_id (the planning frame W) but the retreat direction, which is in
+// the gripper frame F named gripper_frame (the first gripper link; "" without a gripper).
+// With c.has_gripper_pose (the plan had a grasp) gripper_pose = X_WF; otherwise
+// has_gripper_pose = false and gripper_pose is all zero (frame_id empty). The placement
+// fields map one to one onto moveit_msgs/PlaceLocation (doc/manipulation.md).
+void toMsg(const Candidate& candidate, const std::string& frame_id, const std::string& gripper_frame,
+           const ros::Time& stamp, PlacementCandidate* msg);
 
 // Planner progress -> action feedback (elapsed time in seconds).
 void toMsg(const Progress& progress, PlacePlanFeedback* msg);

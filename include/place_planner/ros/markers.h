@@ -7,6 +7,7 @@
 #include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "place_planner/gripper.h"
 #include "place_planner/mesh.h"
 #include "place_planner/planner.h"
 
@@ -19,13 +20,19 @@ constexpr const char* kContactNormals = "contact_normals"; // arrows along the n
 constexpr const char* kFloorPoints = "floor_points";       // orange spheres
 constexpr const char* kBestPath = "best_path";             // best candidate's intermediate poses, faded
 constexpr const char* kQuality = "quality";                // "#1 Q=0.87" text above the best few
+// Manipulation (doc/manipulation.md), for the best few (as the contacts):
+constexpr const char* kApproach = "approach";              // arrow pre-place -> end of the approach
+constexpr const char* kGripper = "gripper";                // the gripper's triangles at X_WF (with a grasp)
+constexpr const char* kRetreat = "retreat";                // the gripper's retreat arrow (with a grasp)
 }  // namespace marker_ns
 
 struct MarkerOptions {
   std::string frame_id = "world";  // the planning frame W
   ros::Time stamp;
   int max_candidates = 10;         // object outlines drawn, best first
-  int text_count = 3;              // quality labels and contacts, best first (contacts: >= 1)
+  int text_count = 3;              // quality labels, contacts, approach/retreat arrows and
+                                   // grippers, best first (>= 1 for all but the labels)
+  const GripperModel* gripper = nullptr;  // drawn at X_WF of candidates with a gripper pose (optional)
 };
 
 // object_O: the object mesh in the frame whose poses the candidates' X_WO give. area_W: the

@@ -3,7 +3,9 @@
 // mirrors both structs; a missing parameter keeps the struct default. Times are in seconds
 // (time_budget_s; the struct's time_budget_ms is filled from it).
 #pragma once
+#include <map>
 #include <string>
+#include <vector>
 
 #include <ros/node_handle.h>
 
@@ -20,6 +22,18 @@ struct NodeConfig {
   // Bullet check of the best K stable candidates after each plan (validation::verifyTopK), within
   // what is left of the time budget; a goal's verify_top_k overrides it. 0 = off.
   int verify_top_k = 0;
+  // The gripper (doc/manipulation.md), loaded once at startup into planner.gripper when
+  // gripper_links is set: the URDF from ~urdf_file when set, else the parameter named
+  // robot_description_param (searched up from the private namespace, as ROS tools do).
+  std::string robot_description_param = "robot_description";
+  std::string urdf_file;                              // "" = use robot_description_param
+  std::vector<std::string> gripper_links;             // first = the gripper frame F; empty = no gripper
+  std::map<std::string, double> gripper_joint_positions;  // rad or m; unlisted joints at 0
+  std::string gripper_mesh_dir;  // relative mesh paths of the URDF: "" = urdf_file's folder (or cwd)
+  // Frames of the shape_msgs/Mesh topics (no header of their own): "" = O for the object
+  // (like an object_mesh without frame id), "" = the planning frame for the area.
+  std::string object_shape_frame;
+  std::string placement_area_shape_frame;
   PlannerConfig planner;
 };
 
@@ -27,6 +41,12 @@ struct NodeConfig {
 // naming the parameter for a wrong type ("parameter /place_planner/gravity must be a list of 3
 // numbers"), an unknown enum value, or a value out of range (place_planner::validate(), e.g.
 // "parameter /place_planner/friction = -0.1 is out of range (0 <= friction <= 10)").
+// With gripper_links set, the gripper is loaded here: a missing or bad URDF, an unknown link
+// or joint, or an unreadable mesh is an std::invalid_argument naming the parameter and the link.
 NodeConfig loadNodeConfig(const ros::NodeHandle& nh);
+
+// "quality" | "lowest" | "nearest"; throws std::invalid_argument ("rank_order = 'x' is unknown ...").
+RankOrder rankOrderFromName(const std::string& name);
+const char* rankOrderName(RankOrder order);
 
 }  // namespace place_planner

@@ -1,6 +1,7 @@
 // The place_planner ROS 1 node: a thin adapter over place_planner::Planner.
 //   action server  ~place_plan   (place_planner/PlacePlan; goals run on a thread of their own)
 //   subscribes     object_mesh, placement_area_mesh   (pcl_msgs/PolygonMesh, remappable)
+//                  object_shape, placement_area_shape (shape_msgs/Mesh, frames: parameters)
 //   publishes      ~markers (visualization_msgs/MarkerArray, latched), ~candidates (PoseArray, latched)
 // Frames (doc/node.md): W = ~planning_frame. The placement area mesh is brought into W by tf2.
 // The object's mesh frame O is located by goal.object_pose; the object mesh's vertices are in
@@ -19,8 +20,10 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <pcl_msgs/PolygonMesh.h>
+#include <shape_msgs/Mesh.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
@@ -57,6 +60,7 @@ class PlacePlannerNode {
   // One goal, start to answer; never throws (an exception is INTERNAL_ERROR).
   Answer execute(const PlacePlanGoal& goal);
   void plan(const PlacePlanGoal& goal, Answer* answer);
+
   // X_WF: pose of `frame` in the planning frame (tf2, waiting up to ~tf_timeout).
   Eigen::Isometry3d lookup(const std::string& frame) const;
   // Between goals: freed heap back to the OS, so that the resident size is what the node holds.
@@ -75,8 +79,14 @@ class PlacePlannerNode {
   ros::Publisher marker_pub_, candidates_pub_;
   ros::WallTimer feedback_timer_;
 
-  std::mutex mesh_mutex_;  // the latest meshes from the topics
+  std::mutex mesh_mutex_;  // the latest meshes from the topics; per mesh the newest of the two kinds
   pcl_msgs::PolygonMeshConstPtr latest_object_, latest_area_;
+  shape_msgs::MeshConstPtr latest_object_shape_, latest_area_shape_;
+  ros::Subscriber object_shape_sub_, area_shape_sub_;
+
+  // Objects one after another (goal thread only): merged into the area so far, and the last
+  // plan's object and candidate poses, which add_to_area takes one from.
+  PlacedObjects placed_;
 
   std::mutex feedback_mutex_;  // progress of the running goal; shared with the feedback timer
   bool planning_ = false;

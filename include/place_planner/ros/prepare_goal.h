@@ -9,8 +9,10 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <pcl_msgs/PolygonMesh.h>
+#include <shape_msgs/Mesh.h>
 
 #include "place_planner/PlacePlanAction.h"
 #include "place_planner/mesh.h"
@@ -38,11 +40,31 @@ struct PreparedGoal {
 };
 
 // The latest meshes received on the node's topics (null: none yet) and the topics' names, for
-// goals whose meshes are empty.
+// goals whose meshes are empty. Per mesh at most one of the PolygonMesh and the shape_msgs/Mesh
+// is set: the one received last (the node drops the other). The shapes carry no header: their
+// vertices are in NodeConfig::object_shape_frame / placement_area_shape_frame.
 struct TopicMeshes {
   pcl_msgs::PolygonMeshConstPtr object, area;
+  shape_msgs::MeshConstPtr object_shape, area_shape;
   std::string object_topic = "object_mesh", area_topic = "placement_area_mesh";
+  std::string object_shape_topic = "object_shape", area_shape_topic = "placement_area_shape";
 };
+
+// Objects one after another (goal fields reset_area, add_to_area, add_candidate): what the
+// node keeps between goals.
+struct PlacedObjects {
+  Mesh added_W;    // objects merged into the area so far, in W (empty: none)
+  int count = 0;   // ... how many
+  bool has_last_plan = false;          // a goal planned (whatever its outcome)
+  Mesh last_object_O;                  // that goal's object, in O
+  std::vector<Eigen::Isometry3d> last_X_WO;  // its candidates' poses, ranked
+};
+
+// reset_area first (drops added_W), then add_to_area (the last plan's object at candidate
+// add_candidate, merged in): the objects this goal's area gets, and their count in *count.
+// Changes nothing; the node keeps the result once the goal is valid. Throws GoalError
+// INVALID_GOAL naming add_to_area (no previous plan) or add_candidate (out of range).
+Mesh areaAdditions(const PlacePlanGoal& goal, const PlacedObjects& placed, int* count);
 
 // X_WF: the pose of `frame` in the planning frame. Called only for frames other than "" and the
 // planning frame (both are W). Throws (tf2::TransformException or any std::exception) when there
@@ -55,7 +77,10 @@ using FrameLookup = std::function<Eigen::Isometry3d(const std::string& frame)>;
 // is out of range (0 <= friction <= 10)"). The use_* rules of the overrides are those of
 // PlacePlan.action: flag true -> the value as given (0 is 0); flag false -> the parameter when
 // the value is 0 or NaN, the value otherwise (goals before issue 10).
+// added_W (optional): objects placed earlier (add_to_area), in W, merged into the placement
+// area. The goal's mesh wins over its shape, which wins over the topics.
 PreparedGoal prepareGoal(const PlacePlanGoal& goal, const TopicMeshes& topics,
-                         const NodeConfig& params, const FrameLookup& lookup);
+                         const NodeConfig& params, const FrameLookup& lookup,
+                         const Mesh* added_W = nullptr);
 
 }  // namespace place_planner

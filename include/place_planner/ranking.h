@@ -18,6 +18,7 @@ struct RankingInput {
   Eigen::Matrix3d R_held_G;   // the held orientation, for the re-orientation key
   double object_radius = 0;   // m, bounding radius (contact summaries)
   Eigen::Vector3d com_O = Eigen::Vector3d::Zero();  // object's centre of mass (kLowest)
+  std::vector<size_t> robust_leaves = {};  // leaves the search already found robust (kept when merging)
 };
 
 // Robustness of the leaves given by index (robustness.h); called on the best stable leaves

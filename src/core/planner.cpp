@@ -386,8 +386,10 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     kinds[k] = roots.kind(k);
     floor_W[k] = result.floor_points_W[roots.floorPoint(k)];
   }
-  const RankingInput in{leaves, kinds, floor_W, am.R_GW, R_held_G, obj.properties.bounding_radius,
-                        obj.properties.center_of_mass};
+  RankingInput in{leaves, kinds, floor_W, am.R_GW, R_held_G, obj.properties.bounding_radius,
+                  obj.properties.center_of_mass};
+  for (const auto& [leaf, r] : monitor.checked)
+    if (r.share() >= config.robust_min_share - 1e-9) in.robust_leaves.push_back(leaf);
   const PlaceabilityContext pc{om, am, *backend, d_vis, config};
   result.candidates = rankCandidates(
       in, config, [&](const std::vector<size_t>& idx) { return monitor.robustnessOf(idx); }, &st,

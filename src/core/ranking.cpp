@@ -72,16 +72,25 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
   const double merge_angle = config.merge_angle_deg * M_PI / 180.0;
   std::vector<Item> distinct;
   std::vector<Eigen::Isometry3d> kept;  // poses of `distinct`, converted once
+  // A leaf the search already found robust stands for its group: it needs no check when the
+  // budget has run out by the ranking.
+  auto robustAlready = [&](size_t leaf) {
+    return std::find(in.robust_leaves.begin(), in.robust_leaves.end(), leaf) != in.robust_leaves.end();
+  };
   for (const Item& it : items) {
     const Eigen::Isometry3d X = toIsometry(leaves[it.leaf].X_GO);
-    bool dup = false;
-    for (const Eigen::Isometry3d& Y : kept)
-      if ((X.translation() - Y.translation()).norm() < config.merge_distance &&
-          rotationAngle(X.linear(), Y.linear()) < merge_angle) {
-        dup = true;
-        break;
+    int dup = -1;
+    for (size_t k = 0; k < kept.size() && dup < 0; ++k)
+      if ((X.translation() - kept[k].translation()).norm() < config.merge_distance &&
+          rotationAngle(X.linear(), kept[k].linear()) < merge_angle)
+        dup = static_cast<int>(k);
+    if (dup >= 0) {
+      if (it.stable && robustAlready(it.leaf) && !robustAlready(distinct[dup].leaf)) {
+        distinct[dup] = it;
+        kept[dup] = X;
       }
-    if (dup) continue;
+      continue;
+    }
     distinct.push_back(it);
     kept.push_back(X);
   }

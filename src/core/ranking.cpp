@@ -77,15 +77,19 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
   auto robustAlready = [&](size_t leaf) {
     return std::find(in.robust_leaves.begin(), in.robust_leaves.end(), leaf) != in.robust_leaves.end();
   };
+  auto close = [&](const Eigen::Isometry3d& X, const Eigen::Isometry3d& Y) {
+    return (X.translation() - Y.translation()).norm() < config.merge_distance &&
+           rotationAngle(X.linear(), Y.linear()) < merge_angle;
+  };
   for (const Item& it : items) {
     const Eigen::Isometry3d X = toIsometry(leaves[it.leaf].X_GO);
-    int dup = -1;
-    for (size_t k = 0; k < kept.size() && dup < 0; ++k)
-      if ((X.translation() - kept[k].translation()).norm() < config.merge_distance &&
-          rotationAngle(X.linear(), kept[k].linear()) < merge_angle)
-        dup = static_cast<int>(k);
-    if (dup >= 0) {
-      if (it.stable && robustAlready(it.leaf) && !robustAlready(distinct[dup].leaf)) {
+    std::vector<size_t> near;
+    for (size_t k = 0; k < kept.size(); ++k)
+      if (close(X, kept[k])) near.push_back(k);
+    if (!near.empty()) {
+      // It takes the group's place only where it is near that group alone (merged stays merged).
+      const size_t dup = near.front();
+      if (near.size() == 1 && it.stable && robustAlready(it.leaf) && !robustAlready(distinct[dup].leaf)) {
         distinct[dup] = it;
         kept[dup] = X;
       }

@@ -1,10 +1,12 @@
-// The node's PolygonMesh -> mesh conversion (src/node/conversions.cpp) under fuzzing: what a
-// goal or a mesh topic may carry. Built where ROS is: the catkin build's fuzz_regression_tests
+// The node's PolygonMesh and shape_msgs/Mesh -> mesh conversions (src/node/conversions.cpp)
+// under fuzzing: what a goal or a mesh topic may carry. Built where ROS is: the catkin build's fuzz_regression_tests
 // and scripts/fuzz (fuzz_polygon_mesh, against the devel space's generated headers).
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <string>
 #include <vector>
 
 #include "fuzz_targets.h"
@@ -84,6 +86,64 @@ void polygonMesh(const uint8_t* data, size_t size) {
   for (size_t i = 0; i < v2.size(); ++i) {
     if (v2[i] != mesh.vertices[i].cast<float>().cast<double>()) violated("round trip changed a vertex");
   }
+}
+
+void shapeMesh(const uint8_t* data, size_t size) {
+  Bytes b(data, size);
+  shape_msgs::Mesh msg;
+  const int n_vertices = b.byte() % 64;
+  for (int i = 0; i < n_vertices; ++i) {
+    geometry_msgs::Point p;
+    // Raw float64 bit patterns sometimes (NaN, Inf, 1e300), small coordinates mostly.
+    auto coordinate = [&] {
+      if (!b.flag()) return b.range(-1, 1);
+      const std::string bits = b.take(8);
+      double v = 0;
+      std::memcpy(&v, bits.data(), std::min<size_t>(8, bits.size()));
+      return v;
+    };
+    p.x = coordinate();
+    p.y = coordinate();
+    p.z = coordinate();
+    msg.vertices.push_back(p);
+  }
+  const int n_triangles = b.byte() % 64;
+  for (int t = 0; t < n_triangles; ++t) {
+    shape_msgs::MeshTriangle tri;
+    for (auto& i : tri.vertex_indices) i = b.flag() ? b.byte() % 72 : b.u32();
+    msg.triangles.push_back(tri);
+  }
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::vector<int>> polygons;
+  try {
+    fromMsg(msg, "fuzz shape", &vertices, &polygons);
+  } catch (const MeshError& e) {
+    // Refused only for an index past the vertices, and the message names the triangle.
+    if (std::string(e.what()).find("triangle") == std::string::npos) violated("shape refused without naming the triangle");
+    return;
+  }
+  if (vertices.size() != msg.vertices.size()) violated("one vertex per shape vertex");
+  if (polygons.size() != msg.triangles.size()) violated("one polygon per shape triangle");
+  for (const auto& p : polygons)
+    for (int i : p)
+      if (i < 0 || i >= static_cast<int>(vertices.size())) violated("an index past the vertices got through");
+  Mesh mesh;
+  try {
+    mesh = buildMesh(vertices, polygons, "fuzz shape");
+  } catch (const MeshError&) {
+    return;
+  }
+  checkMesh(mesh);
+  // And back: float64 both ways, the vertices exactly.
+  shape_msgs::Mesh again;
+  toMsg(mesh, &again);
+  std::vector<Eigen::Vector3d> v2;
+  std::vector<std::vector<int>> p2;
+  fromMsg(again, "round trip", &v2, &p2);
+  if (v2 != mesh.vertices) violated("shape round trip changed a vertex");
+  size_t fan = 0;
+  for (const auto& patch : mesh.patches) fan += patch.size() - 2;
+  if (p2.size() != fan) violated("shape round trip: one triangle per fan triangle of the patches");
 }
 
 }  // namespace fuzz

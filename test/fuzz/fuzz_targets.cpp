@@ -301,6 +301,7 @@ Target targetByName(const std::string& name) {
   if (name == "planner") return planner;
 #ifdef PP_FUZZ_WITH_ROS
   if (name == "polygon_mesh") return polygonMesh;
+  if (name == "shape_mesh") return shapeMesh;
 #endif
   return nullptr;
 }

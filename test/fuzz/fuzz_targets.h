@@ -75,6 +75,8 @@ bool& skipKnownBugs();
 // the bytes (any cloud layout, fields, polygons); a mesh it accepts goes back through toMsg.
 // In fuzz_conversions.cpp: built only where ROS is (the catkin build, scripts/fuzz).
 void polygonMesh(const uint8_t* data, size_t size);
+// The shape_msgs/Mesh conversion (MoveIt's mesh type): raw float64 vertices, any indices.
+void shapeMesh(const uint8_t* data, size_t size);
 #endif
 
 // The target of that name ("ply_text", "ply_binary", "obj", "stl", "planner", and

@@ -111,6 +111,26 @@ def planner_seeds():
     return seeds
 
 
+def shape_mesh(raw=False, bad_index=False):
+    """fuzz_conversions.cpp shapeMesh: vertex count, per coordinate a flag byte then a range()
+    byte (flag 0) or 8 raw float64 bytes (flag 1); triangle count, per index a flag byte then a
+    byte index (flag 1) or 4 bytes (flag 0)."""
+    verts = [(0.0, 0.0, 0.0), (0.5, 0.0, 0.0), (0.0, 0.5, 0.0), (0.0, 0.0, 0.5)]
+    out = bytearray([len(verts)])
+    for p in verts:
+        for c in p:
+            if raw:
+                out += bytes([1]) + struct.pack("<d", c)
+            else:
+                out += bytes([0, max(0, min(255, round((c + 1) * 255 / 2)))])
+    tris = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3 if not bad_index else 9)]
+    out.append(len(tris))
+    for t in tris:
+        for i in t:
+            out += bytes([1, i])
+    return bytes(out)
+
+
 def polygon_mesh(point_step=12, double=False, extra_field=False):
     # As fuzz_conversions.cpp reads it: height, width (u16), point_step, row-step choice, big
     # endian choice, fields (name, offset choice, offset, datatype), polygons, data length, data.
@@ -150,6 +170,9 @@ def main():
     write("polygon_mesh", "tetra_float32_rgb", polygon_mesh(point_step=16, extra_field=True))
     for name, data in planner_seeds().items():
         write("planner", name, data)
+    write("shape_mesh", "tetra", shape_mesh())
+    write("shape_mesh", "tetra_raw_float64", shape_mesh(raw=True))
+    write("shape_mesh", "tetra_bad_index", shape_mesh(bad_index=True))
 
 
 if __name__ == "__main__":

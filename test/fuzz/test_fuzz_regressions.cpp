@@ -68,7 +68,7 @@ TEST_P(FuzzReplay, Regressions) { replay(GetParam(), "regressions", 0); }
 INSTANTIATE_TEST_SUITE_P(Targets, FuzzReplay,
                          testing::Values("ply_text", "ply_binary", "obj", "stl", "planner"
 #ifdef PP_FUZZ_WITH_ROS
-                                         , "polygon_mesh"
+                                         , "polygon_mesh", "shape_mesh"
 #endif
                                          ),
                          [](const testing::TestParamInfo<std::string>& i) { return i.param; });
@@ -245,7 +245,7 @@ TEST(FuzzFindings, DegenerateFarFromOriginIsRefused) {
 TEST(FuzzFindings, KnownFindingsReplay) {
   for (const std::string target : {"ply_text", "ply_binary", "obj", "stl", "planner"
 #ifdef PP_FUZZ_WITH_ROS
-                                    , "polygon_mesh"
+                                    , "polygon_mesh", "shape_mesh"
 #endif
        }) {
     replay(target, "regressions/known", 0);

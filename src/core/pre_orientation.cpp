@@ -20,6 +20,7 @@ std::vector<Eigen::Matrix3d> preOrientations(const MeshProperties& object,
     case OrientationMode::kKeep:
       out.push_back(R_start);
       break;
+    case OrientationMode::kAuto:  // its principal-axis root (start_orientations.cpp adds the rest)
     case OrientationMode::kPrincipalAxis: {
       // k1 || d_vis: "reach the bottom of a box filled with pens or place a plate in a rack".
       const Eigen::Vector3d k1 = object.principal_axes.col(0);

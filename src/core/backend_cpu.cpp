@@ -2,6 +2,7 @@
 // items, host memory for the buffers; the views point into the host models.
 #include <algorithm>
 #include <cstring>
+#include <memory>
 
 #include "place_planner/backend.h"
 #include "place_planner/kernels/batched_steps.h"
@@ -30,11 +31,17 @@ class CpuDevice {
   void parallelFor(size_t n, const F& f) {
     place_planner::parallelFor(n, threads_, f);
   }
+  // Not zeroed: the contact slots are sized for every sphere of every pose, but a pose writes
+  // only its few contacts, so only those pages are ever touched (zeroing them all tripled the
+  // robustness check's time).
   template <typename T>
   T* scratch(int slot, size_t n) {
-    auto& b = buffers_[slot];
-    if (b.size() < n * sizeof(T)) b.resize(n * sizeof(T));
-    return reinterpret_cast<T*>(b.data());
+    Buffer& b = buffers_[slot];
+    if (b.bytes < n * sizeof(T)) {
+      b.bytes = n * sizeof(T) + n * sizeof(T) / 2;
+      b.data.reset(new unsigned char[b.bytes]);
+    }
+    return reinterpret_cast<T*>(b.data.get());
   }
   template <typename T>
   const T* upload(int, const std::vector<T>& host) {
@@ -50,7 +57,11 @@ class CpuDevice {
   ObjectView obj_;
   AreaView area_;
   int threads_;
-  std::vector<unsigned char> buffers_[8];  // by slot; operator new aligns for any scalar
+  struct Buffer {
+    std::unique_ptr<unsigned char[]> data;  // operator new[] aligns for any scalar
+    size_t bytes = 0;
+  };
+  Buffer buffers_[8];  // by slot
 };
 
 }  // namespace

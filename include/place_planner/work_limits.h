@@ -3,6 +3,7 @@
 // cancel or the time budget interrupt the setup steps (models, floor points, resting faces).
 // Frames: none; sizes in metres.
 #pragma once
+#include <array>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -32,6 +33,17 @@ std::vector<std::string> checkMeshSizes(const Mesh& object, const Mesh& area, co
 // Counts are capped at max_triangles (what decimation leaves).
 double estimateModelBytes(const Mesh& mesh, double r, double cd = 0.0, double cell = 0.0,
                           size_t max_triangles = static_cast<size_t>(-1));
+
+// One pass of vertex clustering (Rossignac & Borrel 1993) with cells of size h from the mesh's
+// bounds_min: each vertex snaps to the mean of its cell; a triangle survives when its corners
+// fall in three cells and it keeps some area, once per set of three cells (the first, in
+// triangle order). Cell indices must fit 21 bits (h >= extent / 2^20). Shared by decimated()
+// and the benchmark's validation::decimateByClustering.
+struct Clustered {
+  std::vector<Eigen::Vector3d> vertices;  // cluster means, in order of first vertex
+  std::vector<std::array<int, 3>> triangles;
+};
+Clustered clusterVertices(const Mesh& mesh, double h, const StopSignal* stop = nullptr);
 
 // Vertex clustering on a grid, coarsened until at most max_triangles remain (the only
 // automatic step: a documented loss of detail finer than the returned cell). Frame and

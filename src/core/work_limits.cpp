@@ -62,6 +62,53 @@ double estimateModelBytes(const Mesh& mesh, double r, double cd, double cell, si
   return bytes;
 }
 
+Clustered clusterVertices(const Mesh& mesh, double h, const StopSignal* stop) {
+  const Eigen::Vector3d lo = mesh.properties.bounds_min;
+  std::unordered_map<uint64_t, int> cluster_of_cell;
+  cluster_of_cell.reserve(mesh.vertices.size() / 4 + 16);
+  std::vector<int> cluster(mesh.vertices.size());
+  Clustered out;
+  std::vector<int> count;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    pollStop(stop, i, 1u << 16);
+    const Eigen::Vector3d q = (mesh.vertices[i] - lo) / h;
+    const uint64_t key = (static_cast<uint64_t>(q.x()) & 0x1fffff) |
+                         ((static_cast<uint64_t>(q.y()) & 0x1fffff) << 21) |
+                         ((static_cast<uint64_t>(q.z()) & 0x1fffff) << 42);
+    auto it = cluster_of_cell.emplace(key, static_cast<int>(out.vertices.size())).first;
+    if (it->second == static_cast<int>(out.vertices.size())) out.vertices.emplace_back(0, 0, 0), count.push_back(0);
+    cluster[i] = it->second;
+    out.vertices[it->second] += mesh.vertices[i];
+    ++count[it->second];
+  }
+  for (size_t k = 0; k < out.vertices.size(); ++k) out.vertices[k] /= count[k];
+  // Candidates with their sorted cluster triple; the first of each triple is kept, in order.
+  std::vector<std::pair<std::array<int, 3>, size_t>> keys;
+  std::vector<std::array<int, 3>> tris;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    pollStop(stop, t, 1u << 16);
+    const auto& tri = mesh.triangles[t];
+    const std::array<int, 3> r{cluster[tri[0]], cluster[tri[1]], cluster[tri[2]]};
+    if (r[0] == r[1] || r[1] == r[2] || r[0] == r[2]) continue;
+    std::array<int, 3> k = r;
+    std::sort(k.begin(), k.end());
+    keys.emplace_back(k, tris.size());
+    tris.push_back(r);
+  }
+  if (stop) stop->throwIfRequested();
+  std::sort(keys.begin(), keys.end());
+  if (stop) stop->throwIfRequested();
+  std::vector<char> keep(tris.size(), 0);
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (i == 0 || keys[i].first != keys[i - 1].first) keep[keys[i].second] = 1;
+  const auto& v = out.vertices;
+  for (size_t t = 0; t < tris.size(); ++t) {
+    const auto& r = tris[t];
+    if (keep[t] && (v[r[1]] - v[r[0]]).cross(v[r[2]] - v[r[0]]).norm() >= 1e-14) out.triangles.push_back(r);
+  }
+  return out;
+}
+
 Mesh decimated(const Mesh& mesh, size_t max_triangles, double* cell_out, const StopSignal* stop) {
   if (mesh.triangles.size() <= max_triangles) {
     if (cell_out) *cell_out = 0.0;
@@ -69,40 +116,15 @@ Mesh decimated(const Mesh& mesh, size_t max_triangles, double* cell_out, const S
   }
   // A surface of area A in cells of size h keeps about 2 A / h^2 triangles; start there.
   double h = std::sqrt(2.0 * std::max(mesh.properties.surface_area, 1e-12) / max_triangles);
-  const Eigen::Vector3d lo = mesh.properties.bounds_min;
-  // Cell and cluster indices fit 21 bits each (the keys below).
-  h = std::max(h, (mesh.properties.bounds_max - lo).maxCoeff() / (1 << 20));
+  // Cell and cluster indices fit 21 bits each (clusterVertices' keys).
+  h = std::max(h, (mesh.properties.bounds_max - mesh.properties.bounds_min).maxCoeff() / (1 << 20));
   for (int attempt = 0; attempt < 40; ++attempt, h *= 1.25) {
-    std::unordered_map<uint64_t, int> cluster_of_cell;
-    cluster_of_cell.reserve(mesh.vertices.size() / 4 + 16);
-    std::vector<int> cluster(mesh.vertices.size());
-    std::vector<Eigen::Vector3d> sum;
-    std::vector<int> count;
-    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-      pollStop(stop, i, 1u << 16);
-      const Eigen::Vector3d q = (mesh.vertices[i] - lo) / h;
-      const uint64_t key = (static_cast<uint64_t>(q.x()) & 0x1fffff) |
-                           ((static_cast<uint64_t>(q.y()) & 0x1fffff) << 21) |
-                           ((static_cast<uint64_t>(q.z()) & 0x1fffff) << 42);
-      auto it = cluster_of_cell.emplace(key, static_cast<int>(sum.size())).first;
-      if (it->second == static_cast<int>(sum.size())) sum.emplace_back(0, 0, 0), count.push_back(0);
-      cluster[i] = it->second;
-      sum[it->second] += mesh.vertices[i];
-      ++count[it->second];
-    }
-    // Triangles whose corners fall in three distinct clusters (two on the same three, both
-    // sides of a thin wall, stay: the models take duplicates).
+    const Clustered cl = clusterVertices(mesh, h, stop);
+    if (cl.triangles.size() > max_triangles || cl.triangles.empty() || cl.vertices.size() >= (1u << 21)) continue;
     std::vector<std::vector<int>> polys;
-    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-      pollStop(stop, t, 1u << 16);
-      const auto& tri = mesh.triangles[t];
-      const int a = cluster[tri[0]], b = cluster[tri[1]], c = cluster[tri[2]];
-      if (a != b && b != c && a != c) polys.push_back({a, b, c});
-    }
-    if (polys.size() > max_triangles || polys.empty() || sum.size() >= (1u << 21)) continue;
-    std::vector<Eigen::Vector3d> verts(sum.size());
-    for (size_t k = 0; k < sum.size(); ++k) verts[k] = sum[k] / count[k];
-    Mesh out = buildMesh(verts, polys, "decimated mesh", stop);
+    polys.reserve(cl.triangles.size());
+    for (const auto& t : cl.triangles) polys.push_back({t[0], t[1], t[2]});
+    Mesh out = buildMesh(cl.vertices, polys, "decimated mesh", stop);
     if (out.triangles.size() > max_triangles) continue;
     // The object's mass properties stay the input's: the answer is for the real object.
     const MeshProperties p = out.properties;

@@ -4,13 +4,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
 #include <queue>
 #include <random>
-#include <set>
 #include <stdexcept>
-#include <tuple>
 #include <vector>
+
+#include "place_planner/work_limits.h"
 
 namespace place_planner {
 namespace validation {
@@ -37,44 +36,6 @@ Mesh fromTriangles(const std::vector<Eigen::Vector3d>& vertices,
   return buildMesh(v, polys, name);
 }
 
-// One clustering pass with cell size h: returns the clustered vertices and triangles.
-std::pair<std::vector<Eigen::Vector3d>, std::vector<std::array<int, 3>>> cluster(const Mesh& m,
-                                                                                 double h) {
-  const Eigen::Vector3d lo = m.properties.bounds_min;
-  std::map<std::tuple<long, long, long>, int> cell_of;
-  std::vector<Eigen::Vector3d> sum;
-  std::vector<int> count;
-  std::vector<int> vmap(m.vertices.size());
-  for (size_t i = 0; i < m.vertices.size(); ++i) {
-    const Eigen::Vector3d q = (m.vertices[i] - lo) / h;
-    const auto key = std::make_tuple(static_cast<long>(std::floor(q.x())),
-                                     static_cast<long>(std::floor(q.y())),
-                                     static_cast<long>(std::floor(q.z())));
-    auto it = cell_of.find(key);
-    if (it == cell_of.end()) {
-      it = cell_of.emplace(key, static_cast<int>(sum.size())).first;
-      sum.push_back(Eigen::Vector3d::Zero());
-      count.push_back(0);
-    }
-    vmap[i] = it->second;
-    sum[it->second] += m.vertices[i];
-    ++count[it->second];
-  }
-  for (size_t c = 0; c < sum.size(); ++c) sum[c] /= count[c];
-  std::set<std::array<int, 3>> seen;
-  std::vector<std::array<int, 3>> tris;
-  for (const auto& t : m.triangles) {
-    const std::array<int, 3> r{vmap[t[0]], vmap[t[1]], vmap[t[2]]};
-    if (r[0] == r[1] || r[1] == r[2] || r[0] == r[2]) continue;
-    std::array<int, 3> key = r;
-    std::sort(key.begin(), key.end());
-    if (!seen.insert(key).second) continue;
-    if ((sum[r[1]] - sum[r[0]]).cross(sum[r[2]] - sum[r[0]]).norm() < 1e-14) continue;
-    tris.push_back(r);
-  }
-  return {sum, tris};
-}
-
 }  // namespace
 
 Mesh decimateByClustering(const Mesh& mesh, int target) {
@@ -86,7 +47,7 @@ Mesh decimateByClustering(const Mesh& mesh, int target) {
   long best_err = -1;
   for (int it = 0; it < 40; ++it) {
     const double h = std::sqrt(lo * hi);
-    const int n = static_cast<int>(cluster(mesh, h).second.size());
+    const int n = static_cast<int>(clusterVertices(mesh, h).triangles.size());
     const long err = std::labs(static_cast<long>(n) - target);
     if (best_err < 0 || err < best_err) {
       best_err = err;
@@ -95,8 +56,8 @@ Mesh decimateByClustering(const Mesh& mesh, int target) {
     if (n > target) lo = h; else hi = h;
     if (err == 0 || hi / lo < 1.0005) break;
   }
-  auto [v, t] = cluster(mesh, best_h);
-  return fromTriangles(v, t, "decimated mesh");
+  const Clustered c = clusterVertices(mesh, best_h);
+  return fromTriangles(c.vertices, c.triangles, "decimated mesh");
 }
 
 Mesh punchHoles(const Mesh& mesh, double fraction, std::uint32_t seed, double patch_fraction) {

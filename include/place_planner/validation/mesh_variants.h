@@ -10,7 +10,8 @@ namespace validation {
 
 // Vertex clustering (Rossignac & Borrel 1993): vertices snap to the mean of their cell of a
 // uniform grid; triangles whose corners fall into fewer than three cells vanish, duplicates are
-// removed. The cell size is bisected until the triangle count is closest to target_triangles.
+// removed (work_limits.h clusterVertices, the pass the planner's own decimation uses). The cell
+// size is bisected until the triangle count is closest to target_triangles.
 // Returns the input unchanged when it already has <= target_triangles triangles.
 // Throws std::invalid_argument when target_triangles < 4.
 Mesh decimateByClustering(const Mesh& mesh, int target_triangles);

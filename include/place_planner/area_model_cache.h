@@ -27,9 +27,6 @@ class AreaModelCache {
                                        double sphere_radius, double collision_distance,
                                        double grid_cell, size_t max_triangles = static_cast<size_t>(-1),
                                        const StopSignal* stop = nullptr);
-  // Whether get() with these arguments would be answered from the cache.
-  bool contains(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
-                double collision_distance, double grid_cell, size_t max_triangles = static_cast<size_t>(-1)) const;
   void clear();
   size_t size() const;
 

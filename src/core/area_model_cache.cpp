@@ -49,11 +49,6 @@ std::shared_ptr<const AreaModel> AreaModelCache::find(uint64_t key, const Mesh& 
   return nullptr;
 }
 
-bool AreaModelCache::contains(const Mesh& area, const Eigen::Vector3d& g, double r, double cd, double cell,
-                              size_t max_triangles) const {
-  return find(fingerprint(area, g, r, cd, cell), area, g, r, cd, cell, max_triangles) != nullptr;
-}
-
 std::shared_ptr<const AreaModel> AreaModelCache::get(const Mesh& area, const Eigen::Vector3d& g,
                                                      double r, double cd, double cell, size_t max_triangles,
                                                      const StopSignal* stop) {

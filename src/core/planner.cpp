@@ -165,8 +165,10 @@ auto runStoppable(F&& step, StopSignal& stop, const std::function<bool()>& keep_
 }
 
 // Bounded work (work_limits.h): sizes that say "millimetres", model memory; before any model.
-void checkLimits(const Mesh& object, const Mesh& area, const Radii& rad, bool area_cached,
-                 const PlannerConfig& config, PlanResult& result) {
+// Both models are estimated, the area's even when cached (one that is over the limit was never
+// built): O(triangles), no hash of the area on top of the cache's own.
+void checkLimits(const Mesh& object, const Mesh& area, const Radii& rad, const PlannerConfig& config,
+                 PlanResult& result) {
   for (std::string& w : checkMeshSizes(object, area, config)) result.warnings.push_back(std::move(w));
   for (const Mesh* m : {&object, &area})
     if (m->report.fanned_polygons > 0)
@@ -175,7 +177,7 @@ void checkLimits(const Mesh& object, const Mesh& area, const Radii& rad, bool ar
                                 " self-intersecting polygons triangulated as fans (their shape is approximate)");
   const size_t max_tri = static_cast<size_t>(config.max_triangles);
   const double mb = (estimateModelBytes(object, rad.r, 0, 0, max_tri) +
-                     (area_cached ? 0.0 : estimateModelBytes(area, rad.r_area, rad.cd, rad.cell, max_tri))) /
+                     estimateModelBytes(area, rad.r_area, rad.cd, rad.cell, max_tri)) /
                     (1024.0 * 1024.0);
   if (mb > config.max_model_mb) {
     char msg[400];
@@ -291,7 +293,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   const Radii rad = sphereRadii(object, config);
   st.sphere_radius = rad.r;
   const size_t max_tri = static_cast<size_t>(config.max_triangles);
-  checkLimits(object, area, rad, cache_->contains(area, d_g_W, rad.r_area, rad.cd, rad.cell, max_tri), config, result);
+  checkLimits(object, area, rad, config, result);
   StopSignal stop;  // a cancel or the budget reaches the setup steps through it
   const std::function<bool()> setup_going = [&] { return keepGoing(t0, budget, progress, Progress{}, result); };
   auto tp = Clock::now();

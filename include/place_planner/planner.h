@@ -91,6 +91,7 @@ struct StepTimes {  // wall time per batched step, ms
 struct PlanStats {
   int roots_total = 0;             // floor points x start orientations
   int start_orientations = 0;
+  int roll_bottoms = 0;            // leaves at the bottom of a roll (tree_stepper rollStep), stable or not
   int trees_without_rest = 0;      // trees cut by max_rotations before reaching a resting pose
   int robustness_checked = 0;      // stable leaves whose releases were perturbed
   int robustness_rejected = 0;     // ... found not robust (returned as not stable)

@@ -31,6 +31,10 @@ struct TreeNode {
   // Its last stability test, kept while it turns: a leaf when no turn is found.
   double quality = -1, tipping_angle = 0;
   bool supported = false;
+  // Roll settle (rollStep, beyond the paper): 1 when this pose is the bottom of a roll about a
+  // line of contacts, with `roll_margin` (rad) to the nearest crest of the roll either way.
+  int roll = 0;
+  double roll_margin = 0;
 };
 
 struct TreeLeaf {
@@ -45,6 +49,7 @@ struct TreeLeaf {
   double tipping_angle = 0;  // rad (planar supports)
   std::vector<ContactPoint> contacts;  // frame G
   std::vector<Rigid> path;
+  bool rolled = false;  // it came to rest at the bottom of a roll (rollStep)
 };
 
 struct TreeContext {
@@ -65,7 +70,7 @@ class TreeStepper {
   explicit TreeStepper(const TreeContext& ctx);
   // A tree: its first pose X_GO (also the first entry of its path) and the translation to do.
   void addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax);
-  size_t active() const { return translate_.size() + contact_.size() + rotating_.size(); }
+  size_t active() const { return translate_.size() + contact_.size() + rotating_.size() + rolling_.size(); }
   bool empty() const { return active() == 0; }
   // One batched step of every pending pose; trees that end append their leaves.
   void step(std::vector<TreeLeaf>& leaves);
@@ -78,9 +83,10 @@ class TreeStepper {
   void firstContactStep();                        // V-A
   void contactStep(std::vector<TreeLeaf>& leaves);  // V-B, VI, V-C.1
   void tiltStep(std::vector<TreeLeaf>& leaves);   // V-C.2
+  void rollStep();                                // beyond the paper: a roller's rest
   TreeContext ctx_;
   double diag_;  // of the area's bounds, limits slides
-  std::vector<TreeNode> translate_, contact_, rotating_;
+  std::vector<TreeNode> translate_, contact_, rotating_, rolling_;
 };
 
 // Rotation by `angle` about the axis (s, d) applied after X.

@@ -379,7 +379,10 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   TreeStepper stepper(ctx);
   streamRoots(roots, stepper, om.com, static_cast<int>(backend->preferredBatch()), leaves,
               [&](int started, int open) { return monitor.afterStep(leaves, started, open); });
-  for (const TreeLeaf& l : leaves) st.trees_without_rest += !l.at_rest;
+  for (const TreeLeaf& l : leaves) {
+    st.trees_without_rest += !l.at_rest;
+    st.roll_bottoms += l.rolled;
+  }
 
   // ---- ranking (VI's Q, robust stability, re-orientation)
   std::vector<StartKind> kinds(roots.size());

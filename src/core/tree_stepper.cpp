@@ -25,6 +25,15 @@ double msSince(Clock::time_point t0) {
 const bool kTrace = std::getenv("PP_TRACE") != nullptr;
 constexpr double kSmallTurn = 2.0 * M_PI / 180.0;
 constexpr int kMaxTurnsPerRotation = 4;
+// Roll settle: roll angles searched each way, their step, and the steepest roll axis.
+constexpr int kRollSteps = 24;
+constexpr double kRollStep = 1.0 * M_PI / 180.0;
+constexpr double kMaxRollAxisSlope = 0.34;  // sin 20 degrees
+// The bottom of a roll holds when the crests either way rise at least this (m) above it: a
+// quarter of a 2 mm release drop. Measured: Bullet rolled the scanned YCB marker 30-60 degrees
+// out of valleys 0.1-0.3 mm deep when released 2 mm above them; a round rod has none at all.
+constexpr double kMinRollRise = 5e-4;
+constexpr double kRollBump = 1e-5;  // m, dents a rolling object passes over
 
 Rigid translated(Rigid X, const V3& d) {
   X.t = X.t + d;
@@ -71,7 +80,7 @@ void TreeStepper::addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3
 
 std::vector<int> TreeStepper::openRoots() const {
   std::vector<int> open;
-  for (const auto* list : {&translate_, &contact_, &rotating_})
+  for (const auto* list : {&translate_, &contact_, &rotating_, &rolling_})
     for (const TreeNode& n : *list) open.push_back(n.root);
   std::sort(open.begin(), open.end());
   open.erase(std::unique(open.begin(), open.end()), open.end());
@@ -79,7 +88,7 @@ std::vector<int> TreeStepper::openRoots() const {
 }
 
 void TreeStepper::prune(const std::function<bool(const TreeNode&)>& drop) {
-  for (auto* list : {&translate_, &contact_, &rotating_})
+  for (auto* list : {&translate_, &contact_, &rotating_, &rolling_})
     list->erase(std::remove_if(list->begin(), list->end(), drop), list->end());
 }
 
@@ -87,6 +96,7 @@ void TreeStepper::step(std::vector<TreeLeaf>& leaves) {
   if (!translate_.empty()) firstContactStep();
   if (!contact_.empty()) contactStep(leaves);
   if (!rotating_.empty()) tiltStep(leaves);
+  if (!rolling_.empty()) rollStep();
 }
 
 // ---------------------------------------------------------------- first contact (V-A)
@@ -153,13 +163,30 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
                    n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable,
                    s.tipping_angle * 180 / M_PI, s.quality);
     if (n.contacts.empty()) continue;
-    // One contact or a line of contacts never holds an object (a ball rolls, a cylinder on its
-    // side turns about its line): tilt (Section V-C) about the point or the line. (Accepting a
-    // band of contacts along a line as a support was tried: Bullet rolled every such marker.)
+    // One contact or a line of contacts never holds an object as a polygon (a ball rolls, a
+    // cylinder on its side turns about its line): tilt (Section V-C) about the point or the line.
+    // (Accepting a band of contacts along a line as a support was tried: Bullet rolled every
+    // such marker, its centre of mass not above the true line of contact.)
     const bool line = axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear;
     const bool can_turn = n.depth < ctx_.max_rotations &&
                           n.turns < kMaxTurnsPerRotation * std::max(1, ctx_.max_rotations);
-    if (line && can_turn) {
+    // A line of contacts under the centre of mass: the object lies on a curved side (a
+    // marker, a bottle). Its band of contacts is as wide as the contact tolerance, not as its
+    // support, so it neither holds as a polygon nor tips about the band's edge: it rolls to
+    // the bottom of its roll (rollStep) and holds there when a roll either way lifts it.
+    const bool rolls = axis.layout == ContactLayout::kCollinear && s.com_inside &&
+                       std::abs(axis.d_A.z()) < kMaxRollAxisSlope;
+    if (line && rolls && n.roll == 1) {
+      const bool holds = n.roll_margin >= ctx_.stability.min_tipping_angle;
+      n.tipping_angle = n.roll_margin;
+      leaves.push_back(TreeLeaf{n.X_GO, n.root, holds, true, holds, s.quality, n.roll_margin, n.contacts, n.path, true});
+      continue;
+    }
+    n.roll = 0;
+    if (line && rolls && can_turn) {
+      n.d_A = axis.d_A;
+      rolling_.push_back(std::move(n));
+    } else if (line && can_turn) {
       n.s_A = axis.s_A;
       n.d_A = axis.d_A;
       n.both_directions = true;
@@ -275,6 +302,104 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
       leaves.push_back(TreeLeaf{n.X_GO, n.root, false, true, n.supported, n.quality, n.tipping_angle, n.contacts, n.path});
   }
   rotating_.clear();
+}
+
+// ---------------------------------------------------------------- roll settle (beyond the paper)
+// An object lying on a line of contacts with its centre of mass above them rolls about the line
+// until its centre of mass is lowest. Each pose is rolled about the horizontal line through its
+// centre of mass by -kRollSteps .. kRollSteps steps and dropped to first contact (the exact
+// translation of V-A, batched); the lowest centre of mass is the roll's bottom. At the end of the
+// range it rolls on from there; inside it, the pose is the bottom, and its margin (its tipping
+// angle) is the roll to the nearest crest either way, zero when a crest rises less than
+// kMinRollRise (a round rod has no bottom). Its time counts as the distance step's.
+void TreeStepper::rollStep() {
+  const auto t0 = Clock::now();
+  constexpr int kN = 2 * kRollSteps + 1;
+  const double R = ctx_.om.bounding_radius;
+  std::vector<TranslationQuery> q;
+  q.reserve(rolling_.size() * kN);
+  std::vector<Eigen::Vector3d> axes(rolling_.size()), coms(rolling_.size());
+  for (size_t i = 0; i < rolling_.size(); ++i) {
+    const TreeNode& n = rolling_[i];
+    Eigen::Vector3d d = n.d_A;
+    d.z() = 0;
+    axes[i] = d.normalized();
+    coms[i] = toEigen(apply(n.X_GO, n.com_O));
+    for (int k = -kRollSteps; k <= kRollSteps; ++k) {
+      const double a = k * kRollStep;
+      const double lift = R * std::abs(a) + 0.5 * ctx_.cd;
+      Rigid X = rotatedAbout(n.X_GO, coms[i], axes[i], a);
+      X.t = X.t + v3(0, 0, lift);
+      q.push_back({X, v3(0, 0, -1), lift + 0.5 * ctx_.cd + 0.01});
+    }
+  }
+  std::vector<double> t;
+  ctx_.backend.distance(q, t);
+  for (size_t i = 0; i < rolling_.size(); ++i) {
+    TreeNode& n = rolling_[i];
+    double h[kN];
+    for (int j = 0; j < kN; ++j) {
+      const double tj = t[i * kN + j];
+      // The centre of mass's height after the drop, relative to now (it was rolled about itself).
+      const double lift = R * std::abs((j - kRollSteps) * kRollStep) + 0.5 * ctx_.cd;
+      h[j] = tj >= kInf ? kInf : lift - tj;
+    }
+    // Downhill from where it lies (a dent shallower than kRollBump does not stop it): the bottom
+    // of its own valley, not the lowest of the range.
+    int best = kRollSteps;
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (int dir : {1, -1}) {
+        for (int j = best + dir; j >= 0 && j < kN && h[j] < h[best] + kRollBump; j += dir)
+          if (h[j] < h[best] - 1e-9) {
+            best = j;
+            moved = true;
+            break;
+          }
+        if (moved) break;
+      }
+    }
+    if (h[best] >= kInf) continue;  // nothing below: it falls off the area
+    const Rigid X = translated(q[i * kN + best].X_GO, v3(0, 0, -t[i * kN + best]));
+    n.X_GO = X;
+    n.path.push_back(X);
+    n.turns += 1;  // rolls count against the hard cap only, like small turns
+    // Each way: the crest, the highest rise before the roll descends by more than kMinRollRise
+    // or below the bottom (lower crests are dents it passes over), and the roll to it.
+    struct Crest {
+      double angle, rise;
+      bool at_end;  // still rising where the range ends
+    };
+    auto crest = [&](int dir) {
+      int top = best;
+      for (int j = best + dir; j >= 0 && j < kN; j += dir) {
+        if (h[j] >= h[top]) top = j;
+        // Past the crest: down by more than a barrier, or lower than the bottom.
+        if (h[j] < h[top] - kMinRollRise || h[j] < h[best] - kRollBump)
+          return Crest{std::abs(top - best) * kRollStep, h[top] - h[best], false};
+      }
+      return Crest{std::abs(top - best) * kRollStep, h[top] - h[best], true};
+    };
+    const Crest cp = crest(1), cm = crest(-1);
+    // Not bracketed (the lowest roll at the end of the range, or a side still rising but less
+    // than kMinRollRise where the range ends): roll on from the lowest pose, the range centred
+    // on it. Centred already, the range is what is known.
+    const bool short_side = (cp.at_end && cp.rise < kMinRollRise) || (cm.at_end && cm.rise < kMinRollRise);
+    const bool at_end = best == 0 || best == kN - 1;
+    if (at_end || (short_side && best != kRollSteps)) {
+      n.roll = 0;
+    } else {
+      auto margin = [&](const Crest& c) { return c.rise < kMinRollRise ? 0.0 : c.angle; };
+      n.roll = 1;
+      n.roll_margin = std::min(margin(cp), margin(cm));
+    }
+    if (kTrace)
+      std::fprintf(stderr, "root %d roll %.1f deg, bottom %d margin %.1f deg\n", n.root,
+                   (best - kRollSteps) * kRollStep * 180 / M_PI, n.roll, n.roll_margin * 180 / M_PI);
+    contact_.push_back(std::move(n));
+  }
+  rolling_.clear();
+  addTime(ctx_.times ? &ctx_.times->first_contact : nullptr, t0);
 }
 
 }  // namespace place_planner

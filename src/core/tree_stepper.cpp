@@ -25,9 +25,11 @@ double msSince(Clock::time_point t0) {
 const bool kTrace = std::getenv("PP_TRACE") != nullptr;
 constexpr double kSmallTurn = 2.0 * M_PI / 180.0;
 constexpr int kMaxTurnsPerRotation = 4;
-// Roll settle: roll angles searched each way, their step, and the steepest roll axis.
-constexpr int kRollSteps = 24;
-constexpr double kRollStep = 1.0 * M_PI / 180.0;
+// Roll settle: coarse roll steps searched each way, their size, the fine steps refining a
+// bottom within a coarse step either side, and the steepest roll axis.
+constexpr int kRollSteps = 8;
+constexpr double kRollStep = 3.0 * M_PI / 180.0;
+constexpr int kRollFine = 2;  // 1 degree
 constexpr double kMaxRollAxisSlope = 0.34;  // sin 20 degrees
 // The bottom of a roll holds when the crests either way rise at least this (m) above it: a
 // quarter of a 2 mm release drop. Measured: Bullet rolled the scanned YCB marker 30-60 degrees
@@ -307,43 +309,55 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
 // ---------------------------------------------------------------- roll settle (beyond the paper)
 // An object lying on a line of contacts with its centre of mass above them rolls about the line
 // until its centre of mass is lowest. Each pose is rolled about the horizontal line through its
-// centre of mass by -kRollSteps .. kRollSteps steps and dropped to first contact (the exact
-// translation of V-A, batched); the lowest centre of mass is the roll's bottom. At the end of the
-// range it rolls on from there; inside it, the pose is the bottom, and its margin (its tipping
-// angle) is the roll to the nearest crest either way, zero when a crest rises less than
-// kMinRollRise (a round rod has no bottom). Its time counts as the distance step's.
+// centre of mass by -kRollSteps .. kRollSteps coarse steps and dropped to first contact (the
+// exact translation of V-A, batched); it goes downhill to the bottom of its own valley. At the
+// end of the range it rolls on from there; inside it, the bottom is refined to kRollFine (a
+// second batch), and its margin (its tipping angle) is the roll to the nearer crest, zero when
+// a crest rises less than kMinRollRise (a round rod has no bottom). Its time counts as the
+// distance step's.
+namespace {
+
+struct Crest {
+  double angle, rise;
+  bool at_end;  // still rising where the range ends
+};
+
+}  // namespace
+
 void TreeStepper::rollStep() {
   const auto t0 = Clock::now();
   constexpr int kN = 2 * kRollSteps + 1;
   const double R = ctx_.om.bounding_radius;
-  std::vector<TranslationQuery> q;
-  q.reserve(rolling_.size() * kN);
+  const double gap = 0.5 * ctx_.cd;
   std::vector<Eigen::Vector3d> axes(rolling_.size()), coms(rolling_.size());
   for (size_t i = 0; i < rolling_.size(); ++i) {
-    const TreeNode& n = rolling_[i];
-    Eigen::Vector3d d = n.d_A;
+    Eigen::Vector3d d = rolling_[i].d_A;
     d.z() = 0;
     axes[i] = d.normalized();
-    coms[i] = toEigen(apply(n.X_GO, n.com_O));
-    for (int k = -kRollSteps; k <= kRollSteps; ++k) {
-      const double a = k * kRollStep;
-      const double lift = R * std::abs(a) + 0.5 * ctx_.cd;
-      Rigid X = rotatedAbout(n.X_GO, coms[i], axes[i], a);
-      X.t = X.t + v3(0, 0, lift);
-      q.push_back({X, v3(0, 0, -1), lift + 0.5 * ctx_.cd + 0.01});
-    }
+    coms[i] = toEigen(apply(rolling_[i].X_GO, rolling_[i].com_O));
   }
+  // Rolled by `a` about the line through the centre of mass, lifted clear, to be dropped.
+  auto query = [&](size_t i, double a) {
+    const double lift = R * std::abs(a) + gap;
+    Rigid X = rotatedAbout(rolling_[i].X_GO, coms[i], axes[i], a);
+    X.t = X.t + v3(0, 0, lift);
+    return TranslationQuery{X, v3(0, 0, -1), lift + gap + 0.01};
+  };
+  // The centre of mass's height after the drop, relative to now (it was rolled about itself).
+  auto height = [&](const TranslationQuery& q, double t) { return t >= kInf ? kInf : q.tmax - gap - 0.01 - t; };
+  std::vector<TranslationQuery> q;
+  q.reserve(rolling_.size() * kN);
+  for (size_t i = 0; i < rolling_.size(); ++i)
+    for (int k = -kRollSteps; k <= kRollSteps; ++k) q.push_back(query(i, k * kRollStep));
   std::vector<double> t;
   ctx_.backend.distance(q, t);
+
+  std::vector<int> bottom(rolling_.size(), -1);  // coarse bottom of the bracketed ones
+  std::vector<char> keep(rolling_.size(), 0);     // 0: nothing below any roll (falls off)
   for (size_t i = 0; i < rolling_.size(); ++i) {
     TreeNode& n = rolling_[i];
     double h[kN];
-    for (int j = 0; j < kN; ++j) {
-      const double tj = t[i * kN + j];
-      // The centre of mass's height after the drop, relative to now (it was rolled about itself).
-      const double lift = R * std::abs((j - kRollSteps) * kRollStep) + 0.5 * ctx_.cd;
-      h[j] = tj >= kInf ? kInf : lift - tj;
-    }
+    for (int j = 0; j < kN; ++j) h[j] = height(q[i * kN + j], t[i * kN + j]);
     // Downhill from where it lies (a dent shallower than kRollBump does not stop it): the bottom
     // of its own valley, not the lowest of the range.
     int best = kRollSteps;
@@ -360,21 +374,13 @@ void TreeStepper::rollStep() {
       }
     }
     if (h[best] >= kInf) continue;  // nothing below: it falls off the area
-    const Rigid X = translated(q[i * kN + best].X_GO, v3(0, 0, -t[i * kN + best]));
-    n.X_GO = X;
-    n.path.push_back(X);
-    n.turns += 1;  // rolls count against the hard cap only, like small turns
+    keep[i] = 1;
     // Each way: the crest, the highest rise before the roll descends by more than kMinRollRise
     // or below the bottom (lower crests are dents it passes over), and the roll to it.
-    struct Crest {
-      double angle, rise;
-      bool at_end;  // still rising where the range ends
-    };
     auto crest = [&](int dir) {
       int top = best;
       for (int j = best + dir; j >= 0 && j < kN; j += dir) {
         if (h[j] >= h[top]) top = j;
-        // Past the crest: down by more than a barrier, or lower than the bottom.
         if (h[j] < h[top] - kMinRollRise || h[j] < h[best] - kRollBump)
           return Crest{std::abs(top - best) * kRollStep, h[top] - h[best], false};
       }
@@ -386,16 +392,45 @@ void TreeStepper::rollStep() {
     // on it. Centred already, the range is what is known.
     const bool short_side = (cp.at_end && cp.rise < kMinRollRise) || (cm.at_end && cm.rise < kMinRollRise);
     const bool at_end = best == 0 || best == kN - 1;
+    n.turns += 1;  // rolls count against the hard cap only, like small turns
     if (at_end || (short_side && best != kRollSteps)) {
       n.roll = 0;
+      n.X_GO = translated(q[i * kN + best].X_GO, v3(0, 0, -t[i * kN + best]));
     } else {
       auto margin = [&](const Crest& c) { return c.rise < kMinRollRise ? 0.0 : c.angle; };
       n.roll = 1;
       n.roll_margin = std::min(margin(cp), margin(cm));
+      bottom[i] = best;
     }
+  }
+  // The bracketed bottoms refined: the fine rolls within a coarse step either side.
+  std::vector<TranslationQuery> fq;
+  std::vector<size_t> fi;
+  for (size_t i = 0; i < rolling_.size(); ++i) {
+    if (bottom[i] < 0) continue;
+    const double a0 = (bottom[i] - kRollSteps) * kRollStep;
+    for (int k = -kRollFine; k <= kRollFine; ++k) {
+      fq.push_back(query(i, a0 + k * kRollStep / (kRollFine + 1)));
+      fi.push_back(i);
+    }
+  }
+  std::vector<double> ft;
+  if (!fq.empty()) ctx_.backend.distance(fq, ft);
+  constexpr int kF = 2 * kRollFine + 1;
+  for (size_t i = 0, f = 0; i < rolling_.size(); ++i) {
+    if (bottom[i] < 0) continue;
+    int best = kRollFine;  // the coarse bottom itself
+    for (int k = 0; k < kF; ++k)
+      if (height(fq[f + k], ft[f + k]) < height(fq[f + best], ft[f + best]) - 1e-9) best = k;
+    rolling_[i].X_GO = translated(fq[f + best].X_GO, v3(0, 0, -ft[f + best]));
+    f += kF;
+  }
+  for (size_t i = 0; i < rolling_.size(); ++i) {
+    TreeNode& n = rolling_[i];
+    if (!keep[i]) continue;
+    n.path.push_back(n.X_GO);
     if (kTrace)
-      std::fprintf(stderr, "root %d roll %.1f deg, bottom %d margin %.1f deg\n", n.root,
-                   (best - kRollSteps) * kRollStep * 180 / M_PI, n.roll, n.roll_margin * 180 / M_PI);
+      std::fprintf(stderr, "root %d rolled, bottom %d margin %.1f deg\n", n.root, n.roll, n.roll_margin * 180 / M_PI);
     contact_.push_back(std::move(n));
   }
   rolling_.clear();

@@ -1,6 +1,7 @@
 // The paper's method, step by step (Sections IV-VII). Each step has its own file; plan() reads
-// as the sequence: models, floor points, start orientations, the trees of rotations over all
-// roots (batched), robustness, ranking. Frames: W planning frame, G = W turned so that gravity
+// as the sequence: models (buildModels), floor points and start orientations (findRoots), the
+// trees of rotations over all roots, batched, with robustness (TreeSearch::run), ranking
+// (TreeSearch::rank). Frames: W planning frame, G = W turned so that gravity
 // is -z, O the object's mesh frame.
 #include "place_planner/planner.h"
 
@@ -271,6 +272,187 @@ struct SearchMonitor {
   }
 };
 
+// ------------------------------------------------------------------ one plan, step by step
+// One plan's state shared by its steps: the inputs, the clock and the budget, the answer being
+// built, and the stop signal that a cancel or the budget sends to the setup steps.
+struct PlanRun {
+  PlanRun(const Mesh& o, const Mesh& a, const PlannerConfig& c, const ProgressCallback& p)
+      : object(o), area(a), config(c), progress(p) {}
+  PlanRun(const PlanRun&) = delete;  // setup_going points at this one
+  const Mesh& object;
+  const Mesh& area;
+  const PlannerConfig& config;
+  const ProgressCallback& progress;
+  Clock::time_point t0 = Clock::now();
+  double budget = config.time_budget_ms;
+  PlanResult result;
+  StopSignal stop;
+  std::function<bool()> setup_going = [this] { return keepGoing(t0, budget, progress, Progress{}, result); };
+  PlanStats& st() { return result.stats; }
+};
+
+// The models (III, V-B) and what the steps need of them. Frames: W planning, G gravity -z.
+struct Models {
+  Radii rad{};
+  Eigen::Vector3d d_g_W, d_vis_W;
+  std::optional<Mesh> object_small;  // the object decimated to max_triangles, if it had more
+  double object_cell = 0;             // ... with clusters of this size (m)
+  ObjectModel om;
+  std::shared_ptr<const AreaModel> am;
+  V3 d_vis{0, 0, -1};  // approach direction, G
+  std::unique_ptr<Backend> backend;
+  const Mesh& searched(const Mesh& object) const { return object_small ? *object_small : object; }
+};
+
+// The object's model is built while the area's is built or fetched from the cache; both poll
+// the stop signal. Empty when stopped.
+std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache) {
+  const PlannerConfig& config = run.config;
+  Models m;
+  m.d_g_W = config.gravity.normalized();
+  m.d_vis_W = config.approach.norm() > 1e-9 ? Eigen::Vector3d(config.approach.normalized()) : m.d_g_W;
+  m.rad = sphereRadii(run.object, config);
+  run.st().sphere_radius = m.rad.r;
+  const size_t max_tri = static_cast<size_t>(config.max_triangles);
+  checkLimits(run.object, run.area, m.rad, config, run.result);
+  const auto tp = Clock::now();
+  const bool built = runStoppable(
+                         [&] {
+                           auto area_model = std::async(std::launch::async, [&] {
+                             return cache.get(run.area, m.d_g_W, m.rad.r_area, m.rad.cd, m.rad.cell, max_tri, &run.stop);
+                           });
+                           if (run.object.triangles.size() > max_tri)
+                             m.object_small = decimated(run.object, max_tri, &m.object_cell, &run.stop);
+                           m.om = buildObjectModel(m.searched(run.object), m.rad.r, &run.stop);
+                           m.am = area_model.get();
+                           return true;
+                         },
+                         run.stop, run.setup_going)
+                         .has_value();
+  run.st().steps.setup = msSince(tp);
+  if (!built) return std::nullopt;
+  if (m.object_small)
+    run.result.warnings.push_back(decimationWarning("object mesh", run.object.triangles.size(),
+                                                    m.object_small->triangles.size(), m.object_cell));
+  const AreaModel& am = *m.am;
+  if (am.triangles.size() < am.source_triangles)
+    run.result.warnings.push_back(
+        decimationWarning("placement area mesh", am.source_triangles, am.triangles.size(), am.decimation_cell));
+  warnAboutGravity(run.area, am, m.d_g_W, run.result);
+  m.d_vis = toV3(am.R_GW * m.d_vis_W);
+  m.backend = chooseBackend(m.om, am, TiltParams{0.002, 1e-6 + 1e-4 * m.rad.r}, config);
+  run.st().backend = m.backend->name();
+  return m;
+}
+
+// The roots (IV): floor points (IV-B) by ray casting and start orientations (IV-A); with a
+// grasp, orientations pointing the gripper over max_gripper_tilt_deg are not searched.
+struct Roots {
+  Eigen::Matrix3d R_held_G;
+  std::vector<V3> floor_G;
+  std::vector<StartOrientation> orientations;
+};
+
+std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
+  const AreaModel& am = *m.am;
+  Roots r;
+  r.R_held_G = am.R_GW * run.config.start_orientation.normalized().toRotationMatrix();
+  const auto tp = Clock::now();
+  std::vector<std::string> floor_warnings;
+  std::vector<StartOrientation> all;
+  const bool found = runStoppable(
+                         [&] {
+                           r.floor_G = findFloorPoints(am, run.config, m.d_vis, &run.stop, floor_warnings);
+                           all = startOrientations(m.searched(run.object), r.R_held_G, toEigen(m.d_vis), am,
+                                                   run.config, &run.stop);
+                           return true;
+                         },
+                         run.stop, run.setup_going)
+                         .has_value();
+  run.st().steps.floor_points = msSince(tp);
+  for (std::string& w : floor_warnings) run.result.warnings.push_back(std::move(w));
+  if (!found) return std::nullopt;
+  for (const StartOrientation& o : all)
+    if (gripperTiltOk(o.R_GO, run.config)) r.orientations.push_back(o);
+  if (r.orientations.empty())
+    run.result.warnings.push_back("no start orientation points the gripper within max_gripper_tilt_deg of straight down");
+  for (const V3& p : r.floor_G) run.result.floor_points_W.push_back(am.R_GW.transpose() * toEigen(p));
+  run.st().floor_points_total = static_cast<int>(r.floor_G.size());
+  run.st().start_orientations = static_cast<int>(r.orientations.size());
+  return r;
+}
+
+// The trees of rotations (V, VI) over every root, every pending pose batched (VII-C), with the
+// robustness check (beyond the paper) of new stable leaves while they come, then the ranking.
+class TreeSearch {
+ public:
+  TreeSearch(PlanRun& run, const Models& m, const Roots& r)
+      : run_(run),
+        m_(m),
+        roots_(r.floor_G, r.orientations, m.searched(run.object).properties, *m.am, m.d_vis),
+        ctx_(treeContext(m.searched(run.object), m.om, *m.am, *m.backend, m.rad, run.config, run.st())),
+        rp_(robustnessParams(run.config)),
+        // With the robustness check on, the search leaves a share of the budget for it.
+        monitor_{m.om, *m.am, run.config, run.progress, run.t0,
+                 run.budget * (run.config.robust_check ? kSearchShareOfBudget : 1.0), m.rad.r,
+                 static_cast<int>(r.orientations.size()),
+                 [this](const std::vector<size_t>& idx) { return robustness(idx); }, run.result, {}, 0, 0.0, 0} {
+    run.st().roots_total = roots_.size();
+  }
+
+  void run() {
+    TreeStepper stepper(ctx_);
+    streamRoots(roots_, stepper, m_.om.com, static_cast<int>(m_.backend->preferredBatch()), leaves_,
+                [&](int started, int open) { return monitor_.afterStep(leaves_, started, open); });
+    for (const TreeLeaf& l : leaves_) {
+      run_.st().trees_without_rest += !l.at_rest;
+      run_.st().roll_bottoms += l.rolled;
+    }
+  }
+
+  // Ranking (VI's Q, robust stability, re-orientation, the gripper's placement).
+  void rank(const Roots& r) {
+    const PlannerConfig& config = run_.config;
+    std::vector<StartKind> kinds(roots_.size());
+    std::vector<Eigen::Vector3d> floor_W(roots_.size());
+    for (int k = 0; k < roots_.size(); ++k) {
+      kinds[k] = roots_.kind(k);
+      floor_W[k] = run_.result.floor_points_W[roots_.floorPoint(k)];
+    }
+    const MeshProperties& props = m_.searched(run_.object).properties;
+    RankingInput in{leaves_, kinds, floor_W, m_.am->R_GW, r.R_held_G, props.bounding_radius, props.center_of_mass};
+    for (const auto& [leaf, rb] : monitor_.checked)
+      if (rb.share() >= config.robust_min_share - 1e-9) in.robust_leaves.push_back(leaf);
+    const PlaceabilityContext pc{m_.om, *m_.am, *m_.backend, m_.d_vis, config};
+    run_.result.candidates = rankCandidates(
+        in, config, [&](const std::vector<size_t>& idx) { return monitor_.robustnessOf(idx); }, &run_.st(),
+        [&](size_t i) { return checkPlacement(leaves_[i], pc); });
+    if (config.has_grasp && config.gripper && run_.result.stableCount() == 0 && run_.st().gripper_rejected > 0)
+      run_.result.warnings.push_back("the gripper blocks every stable pose checked (" +
+                                     std::to_string(run_.st().gripper_rejected) +
+                                     " candidates): at the goal, on the approach or the retreat");
+  }
+
+ private:
+  // Robust stability of leaves (robustness.cpp), within what is left of the budget.
+  std::vector<Robustness> robustness(const std::vector<size_t>& idx) {
+    const auto tr = Clock::now();
+    std::vector<Rigid> X;
+    for (size_t i : idx) X.push_back(leaves_[i].X_GO);
+    auto out = checkRobustness(X, ctx_, rp_, [this] { return monitor_.keepGoing(run_.budget); });
+    run_.st().robustness_ms += msSince(tr);
+    return out;
+  }
+
+  PlanRun& run_;
+  const Models& m_;
+  const RootSearch roots_;
+  const TreeContext ctx_;
+  const RobustnessParams rp_;
+  std::vector<TreeLeaf> leaves_;
+  SearchMonitor monitor_;
+};
+
 }  // namespace
 
 Planner::Planner() : cache_(std::make_shared<AreaModelCache>()) {}
@@ -282,129 +464,20 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   validate(config);
   if (object.empty()) throw std::invalid_argument("object mesh is empty");
   if (area.empty()) throw std::invalid_argument("placement area mesh is empty");
-  const auto t0 = Clock::now();
-  PlanResult result;
-  PlanStats& st = result.stats;
-  const double budget = config.time_budget_ms;
-
-  // ---- models (III, V-B): the object's built while the area's is built or fetched
-  const Eigen::Vector3d d_g_W = config.gravity.normalized();
-  const Eigen::Vector3d d_vis_W = config.approach.norm() > 1e-9 ? Eigen::Vector3d(config.approach.normalized()) : d_g_W;
-  const Radii rad = sphereRadii(object, config);
-  st.sphere_radius = rad.r;
-  const size_t max_tri = static_cast<size_t>(config.max_triangles);
-  checkLimits(object, area, rad, config, result);
-  StopSignal stop;  // a cancel or the budget reaches the setup steps through it
-  const std::function<bool()> setup_going = [&] { return keepGoing(t0, budget, progress, Progress{}, result); };
-  auto tp = Clock::now();
-  struct Models {
-    std::optional<Mesh> object_small;  // the object decimated to max_triangles, if it had more
-    double object_cell = 0;             // ... with clusters of this size (m)
-    ObjectModel om;
-    std::shared_ptr<const AreaModel> am;
-  };
-  auto models = runStoppable(
-      [&] {
-        Models m;
-        auto area_model = std::async(std::launch::async, [&] {
-          return cache_->get(area, d_g_W, rad.r_area, rad.cd, rad.cell, max_tri, &stop);
-        });
-        if (object.triangles.size() > max_tri) m.object_small = decimated(object, max_tri, &m.object_cell, &stop);
-        m.om = buildObjectModel(m.object_small ? *m.object_small : object, rad.r, &stop);
-        m.am = area_model.get();
-        return m;
-      },
-      stop, setup_going);
-  st.steps.setup = msSince(tp);
-  if (!models) return stopped(result, t0);
-  const Mesh& obj = models->object_small ? *models->object_small : object;
-  if (models->object_small)
-    result.warnings.push_back(
-        decimationWarning("object mesh", object.triangles.size(), obj.triangles.size(), models->object_cell));
-  const ObjectModel& om = models->om;
-  const AreaModel& am = *models->am;
-  if (am.triangles.size() < am.source_triangles)
-    result.warnings.push_back(
-        decimationWarning("placement area mesh", am.source_triangles, am.triangles.size(), am.decimation_cell));
-  warnAboutGravity(area, am, d_g_W, result);
-  const V3 d_vis = toV3(am.R_GW * d_vis_W);
-  const std::unique_ptr<Backend> backend = chooseBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * rad.r}, config);
-  st.backend = backend->name();
-
+  PlanRun run(object, area, config, progress);
+  // ---- models (III, V-B)
+  const std::optional<Models> models = buildModels(run, *cache_);
+  if (!models) return stopped(run.result, run.t0);
   // ---- floor points (IV-B) and start orientations (IV-A): the roots
-  tp = Clock::now();
-  const Eigen::Matrix3d R_held_G = am.R_GW * config.start_orientation.normalized().toRotationMatrix();
-  using Roots = std::pair<std::vector<V3>, std::vector<StartOrientation>>;
-  std::vector<std::string> floor_warnings;
-  const std::optional<Roots> root_parts = runStoppable(
-      [&] {
-        return Roots(findFloorPoints(am, config, d_vis, &stop, floor_warnings),
-                     startOrientations(obj, R_held_G, toEigen(d_vis), am, config, &stop));
-      },
-      stop, setup_going);
-  st.steps.floor_points = msSince(tp);
-  for (std::string& w : floor_warnings) result.warnings.push_back(std::move(w));
-  if (!root_parts) return stopped(result, t0);
-  const std::vector<V3>& floor_G = root_parts->first;
-  // With a grasp, orientations pointing the gripper over max_gripper_tilt_deg are not searched.
-  std::vector<StartOrientation> orientations;
-  for (const StartOrientation& o : root_parts->second)
-    if (gripperTiltOk(o.R_GO, config)) orientations.push_back(o);
-  if (orientations.empty())
-    result.warnings.push_back("no start orientation points the gripper within max_gripper_tilt_deg of straight down");
-  for (const V3& p : floor_G) result.floor_points_W.push_back(am.R_GW.transpose() * toEigen(p));
-  const RootSearch roots(floor_G, orientations, obj.properties, am, d_vis);
-  st.floor_points_total = static_cast<int>(floor_G.size());
-  st.start_orientations = static_cast<int>(orientations.size());
-  st.roots_total = roots.size();
-
-  // ---- the trees of rotations (V, VI), every pending pose batched (VII-C)
-  const TreeContext ctx = treeContext(obj, om, am, *backend, rad, config, st);
-  const RobustnessParams rp = robustnessParams(config);
-  std::vector<TreeLeaf> leaves;
-  std::function<bool()> robustness_going;  // the monitor's, once it exists
-  auto robustness = [&](const std::vector<size_t>& idx) {  // robust stability, beyond the paper
-    const auto tr = Clock::now();
-    std::vector<Rigid> X;
-    for (size_t i : idx) X.push_back(leaves[i].X_GO);
-    auto out = checkRobustness(X, ctx, rp, robustness_going);
-    st.robustness_ms += msSince(tr);
-    return out;
-  };
-  // With the robustness check on, the search leaves a share of the budget for it.
-  SearchMonitor monitor{om, am, config, progress, t0,
-                        budget * (config.robust_check ? kSearchShareOfBudget : 1.0), rad.r,
-                        static_cast<int>(orientations.size()), robustness, result, {}, 0, 0.0, 0};
-  robustness_going = [&] { return monitor.keepGoing(budget); };
-  TreeStepper stepper(ctx);
-  streamRoots(roots, stepper, om.com, static_cast<int>(backend->preferredBatch()), leaves,
-              [&](int started, int open) { return monitor.afterStep(leaves, started, open); });
-  for (const TreeLeaf& l : leaves) {
-    st.trees_without_rest += !l.at_rest;
-    st.roll_bottoms += l.rolled;
-  }
-
-  // ---- ranking (VI's Q, robust stability, re-orientation)
-  std::vector<StartKind> kinds(roots.size());
-  std::vector<Eigen::Vector3d> floor_W(roots.size());
-  for (int k = 0; k < roots.size(); ++k) {
-    kinds[k] = roots.kind(k);
-    floor_W[k] = result.floor_points_W[roots.floorPoint(k)];
-  }
-  RankingInput in{leaves, kinds, floor_W, am.R_GW, R_held_G, obj.properties.bounding_radius,
-                  obj.properties.center_of_mass};
-  for (const auto& [leaf, r] : monitor.checked)
-    if (r.share() >= config.robust_min_share - 1e-9) in.robust_leaves.push_back(leaf);
-  const PlaceabilityContext pc{om, am, *backend, d_vis, config};
-  result.candidates = rankCandidates(
-      in, config, [&](const std::vector<size_t>& idx) { return monitor.robustnessOf(idx); }, &st,
-      [&](size_t i) { return checkPlacement(leaves[i], pc); });
-  if (config.has_grasp && config.gripper && result.stableCount() == 0 && st.gripper_rejected > 0)
-    result.warnings.push_back("the gripper blocks every stable pose checked (" + std::to_string(st.gripper_rejected) +
-                              " candidates): at the goal, on the approach or the retreat");
-  if (budget > 0 && msSince(t0) > budget) result.timed_out = true;
-  st.total_ms = msSince(t0);
-  return result;
+  const std::optional<Roots> roots = findRoots(run, *models);
+  if (!roots) return stopped(run.result, run.t0);
+  // ---- the trees of rotations (V, VI, VII-C) with robust stability, then the ranking
+  TreeSearch search(run, *models, *roots);
+  search.run();
+  search.rank(*roots);
+  if (run.budget > 0 && msSince(run.t0) > run.budget) run.result.timed_out = true;
+  run.st().total_ms = msSince(run.t0);
+  return std::move(run.result);
 }
 
 }  // namespace place_planner

@@ -30,7 +30,7 @@ struct HeightGrid {
   double collision_distance = 0;
   double contact_gap = 0;    // see sphereContact
   std::vector<int> start;    // nx * ny + 1 offsets into items
-  std::vector<int> items;    // area sphere indices
+  std::vector<int> items;    // area sphere indices, each cell's highest first
   std::vector<double> max_z; // per cell; -inf when empty
 };
 

@@ -141,6 +141,15 @@ HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, 
       });
     }
   });
+  // Each cell's spheres highest first (ties in index order): the contact kernel stops at the
+  // first one below the object sphere's reach, so the layers under a box top (its bottom, the
+  // table, the boxes below) cost nothing.
+  for (size_t k = 0; k < ncell; ++k) {
+    pollStop(stop, k, 4096);
+    std::sort(g.items.begin() + g.start[k], g.items.begin() + g.start[k + 1], [&](int a, int b) {
+      return s.centres[a].z > s.centres[b].z || (s.centres[a].z == s.centres[b].z && a < b);
+    });
+  }
   return g;
 }
 

@@ -328,6 +328,8 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   for (int k = g.start[cell]; k < g.start[cell + 1]; ++k) {
     const int i = g.items[k];
     const V3 a = area.mesh.sphere_centres[i];
+    // A cell's spheres come highest first (buildHeightGrid): below reach, so are the rest.
+    if (a.z <= s_G.z - g.collision_distance) break;
     if (norm2(a - s_G) >= cd2) continue;
     V3 na = area.mesh.sphere_normals[i];
     if (dot(na, com_G - a) < 0) na = -na;

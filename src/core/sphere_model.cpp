@@ -144,12 +144,15 @@ HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, 
   // Each cell's spheres highest first (ties in index order): the contact kernel stops at the
   // first one below the object sphere's reach, so the layers under a box top (its bottom, the
   // table, the boxes below) cost nothing.
-  for (size_t k = 0; k < ncell; ++k) {
-    pollStop(stop, k, 4096);
-    std::sort(g.items.begin() + g.start[k], g.items.begin() + g.start[k + 1], [&](int a, int b) {
-      return s.centres[a].z > s.centres[b].z || (s.centres[a].z == s.centres[b].z && a < b);
-    });
-  }
+  bands([&](int r0, int r1) {
+    for (size_t k = static_cast<size_t>(r0) * g.nx; k < static_cast<size_t>(r1) * g.nx; ++k) {
+      pollStop(stop, k, 4096);
+      if (g.start[k + 1] - g.start[k] < 2) continue;
+      std::sort(g.items.begin() + g.start[k], g.items.begin() + g.start[k + 1], [&](int a, int b) {
+        return s.centres[a].z > s.centres[b].z || (s.centres[a].z == s.centres[b].z && a < b);
+      });
+    }
+  });
   return g;
 }
 

@@ -311,6 +311,7 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
     toMsg(plan.candidates[i], config_.planning_frame, gripper_frame, answer->stamp, &result.candidates[i]);
   }
   result.floor_points_evaluated = plan.stats.floor_points_done;
+  result.trees_without_rest = plan.stats.trees_without_rest;
   result.gripper_rejected = plan.stats.gripper_rejected;
   result.gripper_tilt_rejected = plan.stats.gripper_tilt_rejected;
   result.objects_in_area = placed_.count;

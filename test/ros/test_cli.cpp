@@ -146,6 +146,10 @@ TEST(PlacePlannerCli, StablePoseExitsZeroWithOutcomeLineAndVerifiedTopTwo) {
   const json& k = j.at("candidates");
   ASSERT_GE(k.size(), 2u) << "the cube on the table has at least two stable candidates";
   EXPECT_GT(j.at("stable_candidates").get<int>(), 0);
+  // The trees' statistics: poses evaluated, none cut while tilting (a cube lands on a face).
+  EXPECT_GT(j.at("tree_nodes").get<long>(), 0);
+  EXPECT_EQ(j.at("trees_without_rest").get<int>(), 0);
+  EXPECT_EQ(j.at("roll_bottoms").get<int>(), 0);
   // In rank order: the best two were simulated and a cube resting on a face of the table
   // stays put; the third (if any) was not simulated.
   for (int i = 0; i < 2; ++i) {

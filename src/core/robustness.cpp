@@ -4,11 +4,14 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace place_planner {
 namespace {
 
 constexpr int kTrials = 12;
+const bool kTraceTrials = std::getenv("PP_ROBUST_TRACE") != nullptr;
 
 struct Trial {
   Rigid X_start;  // released here, above the area
@@ -54,9 +57,10 @@ Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const Eigen::Vecto
 
 }  // namespace
 
-std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const TreeContext& ctx_in,
-                                        const RobustnessParams& p,
-                                        const std::function<bool()>& keep_going) {
+namespace {
+std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext& ctx_in,
+                              const RobustnessParams& p, const std::function<bool()>& keep_going,
+                              bool tilted_trials) {
   TreeContext ctx = ctx_in;
   ctx.max_rotations = p.max_rotations;
   ctx.times = nullptr;  // the caller times the whole check
@@ -65,6 +69,7 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
   for (size_t i = 0; i < X_GO.size(); ++i) {
     const Eigen::Vector2d extent = horizontalExtent(X_GO[i], om);
     for (int k = 0; k < kTrials; ++k) {
+      if (!tilted_trials && k >= 4 && k < 8) continue;
       const Trial t = makeTrial(X_GO[i], k, om, extent, p);
       const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
       stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax);
@@ -74,6 +79,12 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
   // statically supported (centre of mass inside its support with the tipping margin: a release
   // that settles a fraction of a degree off flat has a partial contact band).
   std::vector<int> state(X_GO.size() * kTrials, 0);  // 0 open or no leaf, 1 held, -1 failed
+  if (!tilted_trials)
+    for (size_t i = 0; i < X_GO.size(); ++i)
+      for (int k = 4; k < 8; ++k) state[i * kTrials + k] = 1;
+  // Tilted trials caught where they landed (stable, near, within the release tilt): their end
+  // poses, each judged by its own shift and centre-of-mass trials below.
+  std::vector<std::vector<Rigid>> caught(state.size());
   std::vector<double> tip(state.size(), kInf);
   std::vector<int> failures(X_GO.size(), 0);
   // Every trial must hold when min_share is 1: a pose's first failure ends its other trials.
@@ -97,6 +108,9 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
     if (state[trial] != -1) ++failures[trial / kTrials];
     state[trial] = -1;
   };
+  if (kTraceTrials)
+    for (size_t i = 0; i < X_GO.size(); ++i)
+      std::fprintf(stderr, "pose %zu at %.3f %.3f %.3f\n", i, X_GO[i].t.x, X_GO[i].t.y, X_GO[i].t.z);
   std::vector<TreeLeaf> leaves;
   bool finished = true;
   while (!stepper.empty()) {
@@ -107,7 +121,26 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
     leaves.clear();
     stepper.step(leaves);
     for (const TreeLeaf& l : leaves) {
-      const bool held = (l.stable || l.supported) && near(l.X_GO, l.root, 1.0);
+      bool held = (l.stable || l.supported) && near(l.X_GO, l.root, 1.0);
+      const int k = l.root % kTrials;
+      if (!held && tilted_trials && p.recheck_caught && k >= 4 && k < 8 && l.stable &&
+          l.tipping_angle >= p.caught_min_tip && rotationAngle(l.X_GO, X_GO[l.root / kTrials]) <= p.caught_angle &&
+          (toEigen(apply(l.X_GO, om.com)) - toEigen(apply(X_GO[l.root / kTrials], om.com))).norm() <=
+              p.end_distance) {
+        caught[l.root].push_back(l.X_GO);
+        held = true;
+        if (kTraceTrials)
+          std::fprintf(stderr, "caught at %.3f %.3f %.3f k %d tip %.2f Q %.3f contacts %zu\n",
+                       X_GO[l.root / kTrials].t.x, X_GO[l.root / kTrials].t.y, X_GO[l.root / kTrials].t.z, k,
+                       l.tipping_angle * 180 / M_PI, l.quality, l.contacts.size());
+      }
+      if (kTraceTrials) {
+        const size_t i = l.root / kTrials;
+        const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(l.X_GO, om.com));
+        std::fprintf(stderr, "trial pose %zu k %d stable %d supported %d rest %d moved %.4f turned %.2f tip %.2f held %d\n",
+                     i, l.root % kTrials, l.stable, l.supported, l.at_rest, (c1 - c0).norm(),
+                     rotationAngle(l.X_GO, X_GO[i]) * 180 / M_PI, l.tipping_angle * 180 / M_PI, held);
+      }
       if (!held) fail(l.root);
       else if (state[l.root] == 0) state[l.root] = 1;
       if (held) tip[l.root] = std::min(tip[l.root], l.tipping_angle);
@@ -117,13 +150,39 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
     stepper.prune([&](const TreeNode& n) {
       const size_t i = n.root / kTrials;
       if (failures[i] <= allowed && near(n.X_GO, n.root, 2.0)) return false;
-      if (failures[i] <= allowed) fail(n.root);
+      if (failures[i] <= allowed) {
+        if (kTraceTrials)
+          std::fprintf(stderr, "trial pose %zu k %d pruned turned %.2f\n", i, n.root % kTrials,
+                       rotationAngle(n.X_GO, X_GO[i]) * 180 / M_PI);
+        fail(n.root);
+      }
       return true;
     });
   }
   // Trials cut by the caller fail.
   if (!finished)
     for (int r : stepper.openRoots()) fail(r);
+  // A caught tilted trial holds when every pose it ended at holds its own shift and
+  // centre-of-mass trials (the check without tilted trials: no recursion).
+  std::vector<Rigid> ends;
+  std::vector<int> owner;
+  for (size_t r = 0; r < caught.size(); ++r)
+    if (state[r] == 1 && failures[r / kTrials] <= allowed)
+      for (const Rigid& X : caught[r]) {
+        ends.push_back(X);
+        owner.push_back(static_cast<int>(r));
+      }
+  if (!ends.empty() && finished) {
+    const std::vector<Robustness> re = check(ends, ctx_in, p, keep_going, false);
+    for (size_t j = 0; j < ends.size(); ++j) {
+      if (kTraceTrials)
+        std::fprintf(stderr, "recheck at %.3f %.3f %.3f k %d held %d\n", X_GO[owner[j] / kTrials].t.x,
+                     X_GO[owner[j] / kTrials].t.y, X_GO[owner[j] / kTrials].t.z, owner[j] % kTrials, re[j].held);
+      if (re[j].held < re[j].trials) fail(owner[j]);
+    }
+  } else if (!ends.empty()) {
+    for (int r : owner) fail(r);
+  }
   for (int& st : state)
     if (st == 0) st = -1;  // no leaf: the tree vanished (fell off the area)
   std::vector<Robustness> out(X_GO.size());
@@ -139,6 +198,13 @@ std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const Tr
     if (r.held == 0) r.min_tipping_angle = 0;
   }
   return out;
+}
+}  // namespace
+
+std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const TreeContext& ctx,
+                                        const RobustnessParams& p,
+                                        const std::function<bool()>& keep_going) {
+  return check(X_GO, ctx, p, keep_going, true);
 }
 
 }  // namespace place_planner

@@ -297,3 +297,23 @@ TEST(Stability, ContactsFromAboveNeverHold) {
   for (auto& p : c) p.n_W = Eigen::Vector3d(0, 0, 1);  // the same contacts from below hold
   EXPECT_TRUE(evaluateStability(c, Eigen::Vector3d(0, 0, 0.075), StabilityParams{}).stable);
 }
+
+// The caught rule (RobustnessParams::recheck_caught, off by default) must not let a tilted
+// release on a flat table count as caught: there the board comes back flat, 12 / 12 either way,
+// and the rule's end-pose recheck is never needed.
+TEST(Robustness, CaughtRuleKeepsFlatTableStrict) {
+  const Mesh board = scenes::box(0.10, 0.10, 0.01);
+  const Mesh table = scenes::box(0.5, 0.5, 0.02, {0, 0, -0.01});
+  const double r = 0.0005, r_area = 0.00075, cd = r + r_area;
+  const ObjectModel om = buildObjectModel(board, r);
+  const AreaModel am = buildAreaModel(table, Eigen::Vector3d(0, 0, -1), r_area, cd, cd);
+  auto backend = makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2);
+  const TreeContext ctx{om, am, *backend, StabilityParams{0.5, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2};
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(0, 0, 0.005);
+  RobustnessParams p;
+  p.min_share = 0;  // settle every trial
+  EXPECT_EQ(checkRobustness({toRigid(X)}, ctx, p).front().held, 12);
+  p.recheck_caught = true;
+  EXPECT_EQ(checkRobustness({toRigid(X)}, ctx, p).front().held, 12);
+}

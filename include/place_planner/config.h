@@ -45,6 +45,10 @@ struct PlannerConfig {
   double robust_com_offset = 0.05;           // centre of mass off by this share of the object's extent along x, y
   double robust_min_share = 1.0;             // share of perturbed releases that must hold
   bool robust_check = true;                  // false: static stability only (the paper)
+  // Tilted releases caught where they land (3.5 deg off, stable, tipping margin >= 20 deg) also
+  // hold when that pose holds its own shift and centre-of-mass trials: more poses on domed
+  // supports (peg tops), at a measured cost in precision (README, "Caught tilted trials").
+  bool robust_recheck_caught = false;
   double time_budget_ms = 0.0;               // 0 = no budget
   int max_candidates = 10;                   // after ranking and merging
   int threads = 0;                           // 0 = all hardware threads

@@ -27,9 +27,9 @@ struct RobustnessParams {
   double end_roll_move = 0.003;
   // A tilted trial caught where it landed (stable, turned at most caught_angle from the pose)
   // also holds when that end pose holds its own shift and centre-of-mass trials.
-  // Off by default: on the 56 1k scenes it added 4 rack scenes to the coverage but took the
-  // Bullet-confirmed precision from 0.978 to 0.950 (cracker, sugar and pudding boxes near the
-  // rack's edge pass it and slide in Bullet).
+  // Off by default (PlannerConfig::robust_recheck_caught): on the 1k scenes it added 4 rack
+  // scenes to the coverage but took the Bullet-confirmed precision from 0.978 to 0.946
+  // (cracker, sugar and pudding boxes near the rack's edge pass it and slide in Bullet).
   bool recheck_caught = false;
   double caught_angle = 3.5 * M_PI / 180;
   double caught_min_tip = 20.0 * M_PI / 180;

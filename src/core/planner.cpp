@@ -130,6 +130,7 @@ RobustnessParams robustnessParams(const PlannerConfig& config) {
   rp.tilt = config.robust_tilt_deg * M_PI / 180.0;
   rp.com_offset = config.robust_com_offset;
   rp.min_share = config.robust_min_share;
+  rp.recheck_caught = config.robust_recheck_caught;
   return rp;
 }
 

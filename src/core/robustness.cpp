@@ -66,15 +66,8 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   ctx.times = nullptr;  // the caller times the whole check
   TreeStepper stepper(ctx);
   const ObjectModel& om = ctx.om;
-  for (size_t i = 0; i < X_GO.size(); ++i) {
-    const Eigen::Vector2d extent = horizontalExtent(X_GO[i], om);
-    for (int k = 0; k < kTrials; ++k) {
-      if (!tilted_trials && k >= 4 && k < 8) continue;
-      const Trial t = makeTrial(X_GO[i], k, om, extent, p);
-      const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
-      stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax);
-    }
-  }
+  std::vector<Eigen::Vector2d> extent;
+  for (const Rigid& X : X_GO) extent.push_back(horizontalExtent(X, om));
   // A trial holds when it ended (all its leaves: a tree may branch) near the pose, stable or
   // statically supported (centre of mass inside its support with the tipping margin: a release
   // that settles a fraction of a degree off flat has a partial contact band).
@@ -111,53 +104,66 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   if (kTraceTrials)
     for (size_t i = 0; i < X_GO.size(); ++i)
       std::fprintf(stderr, "pose %zu at %.3f %.3f %.3f\n", i, X_GO[i].t.x, X_GO[i].t.y, X_GO[i].t.z);
+  // Two phases: the tilted releases first (the likeliest to fail: a pose they turn down needs
+  // no other trial), then the shifts and the centre-of-mass offsets of the poses still open.
   std::vector<TreeLeaf> leaves;
   bool finished = true;
-  while (!stepper.empty()) {
-    if (keep_going && !keep_going()) {
-      finished = false;
-      break;
+  for (int phase = tilted_trials ? 0 : 1; phase < 2 && finished; ++phase) {
+    for (size_t i = 0; i < X_GO.size(); ++i) {
+      if (failures[i] > allowed) continue;
+      for (int k = 0; k < kTrials; ++k) {
+        if ((k >= 4 && k < 8) != (phase == 0)) continue;
+        const Trial t = makeTrial(X_GO[i], k, om, extent[i], p);
+        const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
+        stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax);
+      }
     }
-    leaves.clear();
-    stepper.step(leaves);
-    for (const TreeLeaf& l : leaves) {
-      bool held = (l.stable || l.supported) && near(l.X_GO, l.root, 1.0);
-      const int k = l.root % kTrials;
-      if (!held && tilted_trials && p.recheck_caught && k >= 4 && k < 8 && l.stable &&
-          l.tipping_angle >= p.caught_min_tip && rotationAngle(l.X_GO, X_GO[l.root / kTrials]) <= p.caught_angle &&
-          (toEigen(apply(l.X_GO, om.com)) - toEigen(apply(X_GO[l.root / kTrials], om.com))).norm() <=
-              p.end_distance) {
-        caught[l.root].push_back(l.X_GO);
-        held = true;
-        if (kTraceTrials)
-          std::fprintf(stderr, "caught at %.3f %.3f %.3f k %d tip %.2f Q %.3f contacts %zu\n",
-                       X_GO[l.root / kTrials].t.x, X_GO[l.root / kTrials].t.y, X_GO[l.root / kTrials].t.z, k,
-                       l.tipping_angle * 180 / M_PI, l.quality, l.contacts.size());
+    while (!stepper.empty()) {
+      if (keep_going && !keep_going()) {
+        finished = false;
+        break;
       }
-      if (kTraceTrials) {
-        const size_t i = l.root / kTrials;
-        const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(l.X_GO, om.com));
-        std::fprintf(stderr, "trial pose %zu k %d stable %d supported %d rest %d moved %.4f turned %.2f tip %.2f held %d\n",
-                     i, l.root % kTrials, l.stable, l.supported, l.at_rest, (c1 - c0).norm(),
-                     rotationAngle(l.X_GO, X_GO[i]) * 180 / M_PI, l.tipping_angle * 180 / M_PI, held);
+      leaves.clear();
+      stepper.step(leaves);
+      for (const TreeLeaf& l : leaves) {
+        bool held = (l.stable || l.supported) && near(l.X_GO, l.root, 1.0);
+        const int k = l.root % kTrials;
+        if (!held && tilted_trials && p.recheck_caught && k >= 4 && k < 8 && l.stable &&
+            l.tipping_angle >= p.caught_min_tip && rotationAngle(l.X_GO, X_GO[l.root / kTrials]) <= p.caught_angle &&
+            (toEigen(apply(l.X_GO, om.com)) - toEigen(apply(X_GO[l.root / kTrials], om.com))).norm() <=
+                p.end_distance) {
+          caught[l.root].push_back(l.X_GO);
+          held = true;
+          if (kTraceTrials)
+            std::fprintf(stderr, "caught at %.3f %.3f %.3f k %d tip %.2f Q %.3f contacts %zu\n",
+                         X_GO[l.root / kTrials].t.x, X_GO[l.root / kTrials].t.y, X_GO[l.root / kTrials].t.z, k,
+                         l.tipping_angle * 180 / M_PI, l.quality, l.contacts.size());
+        }
+        if (kTraceTrials) {
+          const size_t i = l.root / kTrials;
+          const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(l.X_GO, om.com));
+          std::fprintf(stderr, "trial pose %zu k %d stable %d supported %d rest %d moved %.4f turned %.2f tip %.2f held %d\n",
+                       i, l.root % kTrials, l.stable, l.supported, l.at_rest, (c1 - c0).norm(),
+                       rotationAngle(l.X_GO, X_GO[i]) * 180 / M_PI, l.tipping_angle * 180 / M_PI, held);
+        }
+        if (!held) fail(l.root);
+        else if (state[l.root] == 0) state[l.root] = 1;
+        if (held) tip[l.root] = std::min(tip[l.root], l.tipping_angle);
       }
-      if (!held) fail(l.root);
-      else if (state[l.root] == 0) state[l.root] = 1;
-      if (held) tip[l.root] = std::min(tip[l.root], l.tipping_angle);
+      // A trial that has moved or turned twice the limit away does not come back: failed. A pose
+      // with more failures than allowed is decided: its open trials stop.
+      stepper.prune([&](const TreeNode& n) {
+        const size_t i = n.root / kTrials;
+        if (failures[i] <= allowed && near(n.X_GO, n.root, 2.0)) return false;
+        if (failures[i] <= allowed) {
+          if (kTraceTrials)
+            std::fprintf(stderr, "trial pose %zu k %d pruned turned %.2f\n", i, n.root % kTrials,
+                         rotationAngle(n.X_GO, X_GO[i]) * 180 / M_PI);
+          fail(n.root);
+        }
+        return true;
+      });
     }
-    // A trial that has moved or turned twice the limit away does not come back: failed. A pose
-    // with more failures than allowed is decided: its open trials stop.
-    stepper.prune([&](const TreeNode& n) {
-      const size_t i = n.root / kTrials;
-      if (failures[i] <= allowed && near(n.X_GO, n.root, 2.0)) return false;
-      if (failures[i] <= allowed) {
-        if (kTraceTrials)
-          std::fprintf(stderr, "trial pose %zu k %d pruned turned %.2f\n", i, n.root % kTrials,
-                       rotationAngle(n.X_GO, X_GO[i]) * 180 / M_PI);
-        fail(n.root);
-      }
-      return true;
-    });
   }
   // Trials cut by the caller fail.
   if (!finished)

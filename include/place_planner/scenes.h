@@ -16,6 +16,8 @@ namespace scenes {
 Mesh box(double sx, double sy, double sz, const Eigen::Vector3d& center = Eigen::Vector3d::Zero());
 // Closed cylinder along z, radius r, height h, `segments` sides, centred at the origin.
 Mesh cylinder(double r, double h, int segments = 32);
+// The same with an elliptic cross-section: semi-axes a along x, b along y.
+Mesh ellipticCylinder(double a, double b, double h, int segments = 32);
 // A single square plane of side `size` at z = 0 (normal +z), optionally tilted about x.
 Mesh plane(double size_x, double size_y, double tilt_deg = 0.0);
 // Two planes forming a V trough along x, each tilted by +-angle_deg, meeting at z = 0.

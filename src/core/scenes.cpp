@@ -39,12 +39,14 @@ Mesh box(double sx, double sy, double sz, const Eigen::Vector3d& c) {
   return buildMesh(v, f, "box");
 }
 
-Mesh cylinder(double r, double h, int segments) {
+namespace {
+// Closed prism along z over an ellipse (semi-axes a along x, b along y), centred at the origin.
+Mesh ellipticPrism(double a, double b, double h, int segments, const char* name) {
   std::vector<Eigen::Vector3d> v;
   std::vector<std::vector<int>> f;
   for (int i = 0; i < segments; ++i) {
-    const double a = 2 * M_PI * i / segments;
-    v.emplace_back(r * std::cos(a), r * std::sin(a), -h / 2);
+    const double phi = 2 * M_PI * i / segments;
+    v.emplace_back(a * std::cos(phi), b * std::sin(phi), -h / 2);
   }
   for (int i = 0; i < segments; ++i) v.emplace_back(v[i].x(), v[i].y(), h / 2);
   std::vector<int> bottom, top;
@@ -56,7 +58,14 @@ Mesh cylinder(double r, double h, int segments) {
   }
   f.push_back(bottom);
   f.push_back(top);
-  return buildMesh(v, f, "cylinder");
+  return buildMesh(v, f, name);
+}
+}  // namespace
+
+Mesh cylinder(double r, double h, int segments) { return ellipticPrism(r, r, h, segments, "cylinder"); }
+
+Mesh ellipticCylinder(double a, double b, double h, int segments) {
+  return ellipticPrism(a, b, h, segments, "elliptic cylinder");
 }
 
 Mesh plane(double sx, double sy, double tilt_deg) {

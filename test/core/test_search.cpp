@@ -50,27 +50,6 @@ Mesh icosphere(double radius, int subdivisions) {
   return buildMesh(v, polys, "ball");
 }
 
-// A prism along z whose cross-section is an ellipse (semi-axes a along x, b along y).
-Mesh ellipticPrism(double a, double b, double h, int segments) {
-  std::vector<Eigen::Vector3d> v;
-  std::vector<std::vector<int>> f;
-  for (int i = 0; i < segments; ++i) {
-    const double phi = 2 * M_PI * i / segments;
-    v.emplace_back(a * std::cos(phi), b * std::sin(phi), -h / 2);
-  }
-  for (int i = 0; i < segments; ++i) v.emplace_back(v[i].x(), v[i].y(), h / 2);
-  std::vector<int> bottom, top;
-  for (int i = 0; i < segments; ++i) {
-    bottom.push_back(segments - 1 - i);
-    top.push_back(segments + i);
-    const int j = (i + 1) % segments;
-    f.push_back({i, j, segments + j, segments + i});
-  }
-  f.push_back(bottom);
-  f.push_back(top);
-  return buildMesh(v, f, "elliptic prism");
-}
-
 double minZ(const Mesh& m, const Candidate& c) {
   double z = 1e9;
   for (const auto& v : m.vertices) z = std::min(z, (c.X_WO * v).z());
@@ -159,7 +138,7 @@ TEST(Search, MarkerReleasedOnItsEnds) {
 // A rod on its side rolls until its centre of mass is lowest and holds there: an elliptic rod
 // released rolled 40 degrees off comes to rest on its flat side (its short axis vertical).
 TEST(Search, EllipticRodRollsToItsFlatSide) {
-  const Mesh rod = ellipticPrism(0.016, 0.012, 0.10, 192);
+  const Mesh rod = scenes::ellipticCylinder(0.016, 0.012, 0.10, 192);
   PlannerConfig cfg;
   cfg.orientation = OrientationMode::kKeep;
   cfg.floor_point_spacing = 0.3;

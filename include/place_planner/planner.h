@@ -93,6 +93,7 @@ struct PlanStats {
   int start_orientations = 0;
   int roll_bottoms = 0;            // leaves at the bottom of a roll (tree_stepper rollStep), stable or not
   int trees_without_rest = 0;      // trees cut by max_rotations before reaching a resting pose
+  int trees_fallen = 0;            // trees cut while falling over a ledge (TreeContext::fall_tip)
   int robustness_checked = 0;      // stable leaves whose releases were perturbed
   int robustness_rejected = 0;     // ... found not robust (returned as not stable)
   int gripper_rejected = 0;        // candidates the gripper blocks (dropped unless keep_colliding)

@@ -3,6 +3,7 @@
 // translations pending; its leaves are resting poses (stable or not).
 #pragma once
 #include <Eigen/Core>
+#include <cmath>
 #include <functional>
 #include <vector>
 
@@ -35,6 +36,7 @@ struct TreeNode {
   // line of contacts, with `roll_margin` (rad) to the nearest crest of the roll either way.
   int roll = 0;
   double roll_margin = 0;
+  bool overhang = false;  // its last pose was past its support over a drop (see fall_tip)
 };
 
 struct TreeLeaf {
@@ -50,6 +52,7 @@ struct TreeLeaf {
   std::vector<ContactPoint> contacts;  // frame G
   std::vector<Rigid> path;
   bool rolled = false;  // it came to rest at the bottom of a roll (rollStep)
+  bool fell = false;    // the tree was cut while falling over a ledge (TreeContext::fall_tip)
 };
 
 struct TreeContext {
@@ -63,6 +66,9 @@ struct TreeContext {
   int threads = 0;
   StepTimes* times = nullptr;  // accumulated per step, may be null
   long* tree_nodes = nullptr;  // poses evaluated, may be null
+  // A tree ends, not stable, when two poses in a row have their centre of mass more than this
+  // (rad) past their support, over a drop (tree_stepper.cpp); 0: never.
+  double fall_tip = 35.0 * M_PI / 180.0;
 };
 
 class TreeStepper {

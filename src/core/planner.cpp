@@ -408,6 +408,7 @@ class TreeSearch {
     for (const TreeLeaf& l : leaves_) {
       run_.st().trees_without_rest += !l.at_rest;
       run_.st().roll_bottoms += l.rolled;
+      run_.st().trees_fallen += l.fell;
     }
   }
 

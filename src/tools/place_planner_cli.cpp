@@ -254,6 +254,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
   j["tree_nodes"] = st.tree_nodes;
   j["trees_without_rest"] = st.trees_without_rest;  // cut by max_rotations while still tilting
   j["roll_bottoms"] = st.roll_bottoms;              // leaves at the bottom of a roll
+  j["trees_fallen"] = st.trees_fallen;              // cut while falling over a ledge
   j["backend"] = st.backend;
   j["gravity"] = vecJson(c.gravity);
   j["warnings"] = r.warnings;
@@ -318,9 +319,10 @@ void printReport(const std::string& object_spec, const Mesh& object, const std::
               st.backend.c_str(), toString(c.orientation).c_str());
   std::printf("floor points %d of %d, tree nodes %ld, planning %.1f ms, first stable %.1f ms\n",
               st.floor_points_done, st.floor_points_total, st.tree_nodes, st.total_ms, st.first_stable_ms);
-  if (st.trees_without_rest > 0 || st.roll_bottoms > 0)
-    std::printf("trees: %d cut by max_rotations while still tilting, %d ended at the bottom of a roll\n",
-                st.trees_without_rest, st.roll_bottoms);
+  if (st.trees_without_rest > 0 || st.roll_bottoms > 0 || st.trees_fallen > 0)
+    std::printf("trees: %d cut by max_rotations while still tilting, %d ended at the bottom of a roll, "
+                "%d cut while falling over a ledge\n",
+                st.trees_without_rest, st.roll_bottoms, st.trees_fallen);
   std::printf("steps [ms]: setup %.1f, floor points %.1f, distance %.1f, contacts %.1f, vertex/surface %.1f, "
               "edge/edge %.1f, stability %.1f, local optimisation %.1f, robustness %.1f\n",
               st.steps.setup, st.steps.floor_points, st.steps.first_contact, st.steps.contact_points,

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -136,6 +137,12 @@ int main(int argc, char** argv) {
   }
   if (out.empty()) usage("--out is required");
   if (plots.empty()) plots = out;
+  // Made before the long run, so that a path that cannot be written fails now, not at the end.
+  for (const std::string& dir : {out, plots}) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) usage(("cannot create the directory " + dir + ": " + ec.message()).c_str());
+  }
 
   std::vector<ScenePair> pairs;
   for (const auto& p : defaultPairs(data)) {

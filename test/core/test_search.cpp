@@ -9,6 +9,7 @@
 #include "place_planner/resting_faces.h"
 #include "place_planner/robustness.h"
 #include "place_planner/stability.h"
+#include "place_planner/tree_stepper.h"
 #include "test_helpers.h"
 
 using namespace place_planner;
@@ -160,6 +161,52 @@ TEST(Search, EllipticRodRollsToItsFlatSide) {
   EXPECT_GT(round.stats.tree_nodes, 0);
   for (const auto& c : round.candidates)
     if (c.stable) EXPECT_GT(std::abs((c.X_WO.linear() * Eigen::Vector3d::UnitZ()).z()), 0.99) << "a round rod held on its side";
+}
+
+// The mug released upright along two lines across books_stack (three scanned boxes stacked
+// with offsets): where it is released over an edge it tips over it and falls, and its tree
+// ends there (TreeContext::fall_tip) instead of walking down the scan's edge facet by facet.
+// The cut saves work and loses no resting pose the walk would have found on a box's top.
+TEST(Search, MugOverTheEdgesOfBooksIsCutWhileFalling) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh books = loadMesh(test::sharedData() + "/areas/books_stack.ply");
+  const double r = 0.0015, r_area = 0.00225, cd = r + r_area;
+  const ObjectModel om = buildObjectModel(mug, r);
+  const AreaModel am = buildAreaModel(books, Eigen::Vector3d(0, 0, -1), r_area, cd, cd);
+  auto backend = makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2);
+  struct Run {
+    long nodes = 0;
+    int fell = 0, stable = 0;
+    std::vector<TreeLeaf> leaves;
+  };
+  auto run = [&](double fall_tip) {
+    Run out;
+    TreeContext ctx{om, am, *backend, StabilityParams{0.2, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2};
+    ctx.tree_nodes = &out.nodes;
+    ctx.fall_tip = fall_tip;
+    TreeStepper stepper(ctx);
+    int root = 0;
+    for (double y : {-0.1, 0.0, 0.1})
+      for (double x = -0.28; x <= 0.28; x += 0.02, ++root) {
+        Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+        X.translation() = Eigen::Vector3d(x, y, 0.3);
+        stepper.addRoot(toRigid(X), root, om.com, v3(0, 0, -1), 0.5);
+      }
+    for (int i = 0; i < 500 && !stepper.empty(); ++i) stepper.step(out.leaves);
+    EXPECT_TRUE(stepper.empty());
+    for (const TreeLeaf& l : out.leaves) {
+      out.fell += l.fell;
+      out.stable += l.stable;
+      if (l.fell) EXPECT_FALSE(l.stable);
+    }
+    return out;
+  };
+  const Run cut = run(35 * M_PI / 180), walked = run(0.0);
+  EXPECT_GT(cut.fell, 0) << "no tree was cut while falling";
+  EXPECT_EQ(walked.fell, 0);
+  EXPECT_LT(cut.nodes, 0.85 * walked.nodes) << "the cut saved little work";
+  EXPECT_EQ(cut.stable, walked.stable);
 }
 
 TEST(Search, MugOnTableWithDefaultsStandsOnItsBase) {

@@ -150,6 +150,7 @@ TEST(PlacePlannerCli, StablePoseExitsZeroWithOutcomeLineAndVerifiedTopTwo) {
   EXPECT_GT(j.at("tree_nodes").get<long>(), 0);
   EXPECT_EQ(j.at("trees_without_rest").get<int>(), 0);
   EXPECT_EQ(j.at("roll_bottoms").get<int>(), 0);
+  EXPECT_EQ(j.at("trees_fallen").get<int>(), 0) << "released over the table, no cube goes over its edge";
   // In rank order: the best two were simulated and a cube resting on a face of the table
   // stays put; the third (if any) was not simulated.
   for (int i = 0; i < 2; ++i) {

@@ -49,6 +49,11 @@ struct PlannerConfig {
   // hold when that pose holds its own shift and centre-of-mass trials: more poses on domed
   // supports (peg tops), at a measured cost in precision (README, "Caught tilted trials").
   bool robust_recheck_caught = false;
+  // Rock settle (tree_stepper.cpp): a pose the static test holds is rocked 1 degree about the
+  // horizontal axes through its centre of mass and moves where that lowers it, so a tilted
+  // release on domes, rims or a dish's underside comes back to its rest. More poses on racks,
+  // cups and trays, at a measured cost in precision (README, "Rock settle").
+  bool rock_settle = false;
   double time_budget_ms = 0.0;               // 0 = no budget
   int max_candidates = 10;                   // after ranking and merging
   int threads = 0;                           // 0 = all hardware threads

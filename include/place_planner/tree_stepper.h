@@ -36,6 +36,7 @@ struct TreeNode {
   // line of contacts, with `roll_margin` (rad) to the nearest crest of the roll either way.
   int roll = 0;
   double roll_margin = 0;
+  int rocks = 0;          // rock settle steps taken (rockStep)
   bool overhang = false;  // its last pose was past its support over a drop (see fall_tip)
 };
 
@@ -69,6 +70,9 @@ struct TreeContext {
   // A tree ends, not stable, when two poses in a row have their centre of mass more than this
   // (rad) past their support, over a drop (tree_stepper.cpp); 0: never.
   double fall_tip = 35.0 * M_PI / 180.0;
+  // A stable pose is rocked about the horizontal axes through its centre of mass and moves
+  // where a rock lowers it (rockStep); false: the static test decides alone.
+  bool rock_settle = false;
 };
 
 class TreeStepper {
@@ -76,7 +80,9 @@ class TreeStepper {
   explicit TreeStepper(const TreeContext& ctx);
   // A tree: its first pose X_GO (also the first entry of its path) and the translation to do.
   void addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax);
-  size_t active() const { return translate_.size() + contact_.size() + rotating_.size() + rolling_.size(); }
+  size_t active() const {
+    return translate_.size() + contact_.size() + rotating_.size() + rolling_.size() + rocking_.size();
+  }
   bool empty() const { return active() == 0; }
   // One batched step of every pending pose; trees that end append their leaves.
   void step(std::vector<TreeLeaf>& leaves);
@@ -90,9 +96,10 @@ class TreeStepper {
   void contactStep(std::vector<TreeLeaf>& leaves);  // V-B, VI, V-C.1
   void tiltStep(std::vector<TreeLeaf>& leaves);   // V-C.2
   void rollStep();                                // beyond the paper: a roller's rest
+  void rockStep(std::vector<TreeLeaf>& leaves);   // beyond the paper: at rest, or rocking
   TreeContext ctx_;
   double diag_;  // of the area's bounds, limits slides
-  std::vector<TreeNode> translate_, contact_, rotating_, rolling_;
+  std::vector<TreeNode> translate_, contact_, rotating_, rolling_, rocking_;
 };
 
 // Rotation by `angle` about the axis (s, d) applied after X.

@@ -120,8 +120,10 @@ TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaMod
   std::sort(ext.data(), ext.data() + 3);
   const StabilityParams sp{config.friction, 1.5 * rad.cd, config.min_tipping_angle_deg * M_PI / 180.0,
                            std::min(config.min_support_width, 0.25 * ext[1])};
-  return TreeContext{om, am, backend, sp, rad.cd, config.max_rotations, config.max_local_optimisation_steps,
-                     config.threads, &st.steps, &st.tree_nodes};
+  TreeContext ctx{om, am, backend, sp, rad.cd, config.max_rotations, config.max_local_optimisation_steps,
+                  config.threads, &st.steps, &st.tree_nodes};
+  ctx.rock_settle = config.rock_settle;
+  return ctx;
 }
 
 RobustnessParams robustnessParams(const PlannerConfig& config) {
@@ -220,6 +222,7 @@ struct SearchMonitor {
   PlanResult& result;
   std::vector<std::pair<size_t, Robustness>> checked;  // leaf index, its robustness
   size_t seen = 0;
+  size_t chunk = 1;  // leaves checked together while no robust one is found
   double best_q = 0;
   int stable_count = 0;
 
@@ -232,19 +235,35 @@ struct SearchMonitor {
 
   bool afterStep(std::vector<TreeLeaf>& all, int started, int open) {
     PlanStats& st = result.stats;
+    std::vector<size_t> fresh;
     for (; seen < all.size(); ++seen) {
       TreeLeaf& l = all[seen];
       // Penetration guard: an object inside the area by more than a sphere radius is not stable.
       if (l.stable && penetrationDepth(om, am, l.X_GO) > penetration_limit) l.stable = false;
-      if (!l.stable) continue;
-      if (st.first_stable_ms < 0 && config.robust_check) {
-        const Robustness r = robustness({seen}).front();
-        checked.emplace_back(seen, r);
-        if (r.share() < config.robust_min_share - 1e-9) continue;
+      if (l.stable) fresh.push_back(seen);
+    }
+    // Until a robust stable pose is found, the new stable leaves are checked at once, in chunks
+    // that double while none holds (1, 2, 4, 8: many trials in flight where poses keep failing,
+    // as on peg tops; one check where the first holds).
+    size_t j = 0;
+    while (j < fresh.size() && st.first_stable_ms < 0 && config.robust_check) {
+      const size_t n = std::min(fresh.size() - j, chunk);
+      const std::vector<size_t> batch(fresh.begin() + j, fresh.begin() + j + n);
+      const std::vector<Robustness> rs = robustness(batch);
+      for (size_t k = 0; k < n; ++k) {
+        checked.emplace_back(batch[k], rs[k]);
+        if (rs[k].share() < config.robust_min_share - 1e-9) continue;
+        if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);
+        ++stable_count;
+        best_q = std::max(best_q, all[batch[k]].quality);
       }
-      if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);
+      j += n;
+      chunk = std::min<size_t>(2 * chunk, 8);
+    }
+    for (; j < fresh.size(); ++j) {
+      if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);  // not checked: no robustness check
       ++stable_count;
-      best_q = std::max(best_q, l.quality);
+      best_q = std::max(best_q, all[fresh[j]].quality);
     }
     st.floor_points_done = (started - open) / std::max(1, orientations);
     if (st.tree_nodes >= config.max_tree_nodes) {
@@ -397,7 +416,7 @@ class TreeSearch {
         monitor_{m.om, *m.am, run.config, run.progress, run.t0,
                  run.budget * (run.config.robust_check ? kSearchShareOfBudget : 1.0), m.rad.r,
                  static_cast<int>(r.orientations.size()),
-                 [this](const std::vector<size_t>& idx) { return robustness(idx); }, run.result, {}, 0, 0.0, 0} {
+                 [this](const std::vector<size_t>& idx) { return robustness(idx); }, run.result, {}, 0, 1, 0.0, 0} {
     run.st().roots_total = roots_.size();
   }
 

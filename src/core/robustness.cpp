@@ -104,15 +104,19 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   if (kTraceTrials)
     for (size_t i = 0; i < X_GO.size(); ++i)
       std::fprintf(stderr, "pose %zu at %.3f %.3f %.3f\n", i, X_GO[i].t.x, X_GO[i].t.y, X_GO[i].t.z);
-  // Two phases: the tilted releases first (the likeliest to fail: a pose they turn down needs
-  // no other trial), then the shifts and the centre-of-mass offsets of the poses still open.
+  // In phases: the tilted releases first (the likeliest to fail: a pose they turn down needs
+  // no other trial), one about x and one about y, then the other two, then the shifts and the
+  // centre-of-mass offsets of the poses still open. Most poses that fail, fail the first
+  // phase: on books_stack in principal_axis mode (55 poses checked, none robust) the trials'
+  // tree nodes went 882 -> 753 against all four tilts at once.
+  static constexpr int kPhaseOf[kTrials] = {2, 2, 2, 2, 0, 1, 0, 1, 2, 2, 2, 2};
   std::vector<TreeLeaf> leaves;
   bool finished = true;
-  for (int phase = tilted_trials ? 0 : 1; phase < 2 && finished; ++phase) {
+  for (int phase = tilted_trials ? 0 : 2; phase < 3 && finished; ++phase) {
     for (size_t i = 0; i < X_GO.size(); ++i) {
       if (failures[i] > allowed) continue;
       for (int k = 0; k < kTrials; ++k) {
-        if ((k >= 4 && k < 8) != (phase == 0)) continue;
+        if (kPhaseOf[k] != phase) continue;
         const Trial t = makeTrial(X_GO[i], k, om, extent[i], p);
         const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
         stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax);

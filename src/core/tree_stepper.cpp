@@ -25,6 +25,7 @@ double msSince(Clock::time_point t0) {
 const bool kTrace = std::getenv("PP_TRACE") != nullptr;
 constexpr double kSmallTurn = 2.0 * M_PI / 180.0;
 constexpr int kMaxTurnsPerRotation = 4;
+constexpr int kMaxRocks = 8;  // rock settle steps per tree
 // Roll settle: coarse roll steps searched each way, their size, the fine steps refining a
 // bottom within a coarse step either side, and the steepest roll axis.
 constexpr int kRollSteps = 8;
@@ -36,6 +37,11 @@ constexpr double kMaxRollAxisSlope = 0.34;  // sin 20 degrees
 // out of valleys 0.1-0.3 mm deep when released 2 mm above them; a round rod has none at all.
 constexpr double kMinRollRise = 5e-4;
 constexpr double kRollBump = 1e-5;  // m, dents a rolling object passes over
+// Rock settle: the rock tried about each horizontal axis of G, and the drop of the centre of
+// mass (m) that makes the pose rock there (a tenth of a millimetre: above a scan's dents under a
+// 1 degree rock, well below the 0.3-1 mm a pose propped a few degrees off drops).
+constexpr double kRockStep = 1.0 * M_PI / 180.0;
+constexpr double kRockDrop = 1e-4;
 // Falling (TreeContext::fall_tip): the area under the centre of mass (the highest surface within
 // kFallProbe of it, m) lies more than kFallDrop (m) below the lowest contact: a drop, not a floor.
 constexpr double kFallDrop = 0.01;
@@ -98,7 +104,7 @@ void TreeStepper::addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3
 
 std::vector<int> TreeStepper::openRoots() const {
   std::vector<int> open;
-  for (const auto* list : {&translate_, &contact_, &rotating_, &rolling_})
+  for (const auto* list : {&translate_, &contact_, &rotating_, &rolling_, &rocking_})
     for (const TreeNode& n : *list) open.push_back(n.root);
   std::sort(open.begin(), open.end());
   open.erase(std::unique(open.begin(), open.end()), open.end());
@@ -106,7 +112,7 @@ std::vector<int> TreeStepper::openRoots() const {
 }
 
 void TreeStepper::prune(const std::function<bool(const TreeNode&)>& drop) {
-  for (auto* list : {&translate_, &contact_, &rotating_, &rolling_})
+  for (auto* list : {&translate_, &contact_, &rotating_, &rolling_, &rocking_})
     list->erase(std::remove_if(list->begin(), list->end(), drop), list->end());
 }
 
@@ -115,6 +121,7 @@ void TreeStepper::step(std::vector<TreeLeaf>& leaves) {
   if (!contact_.empty()) contactStep(leaves);
   if (!rotating_.empty()) tiltStep(leaves);
   if (!rolling_.empty()) rollStep();
+  if (!rocking_.empty()) rockStep(leaves);
 }
 
 // ---------------------------------------------------------------- first contact (V-A)
@@ -231,6 +238,8 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
       rotating_.push_back(std::move(n));
     } else if (line) {
       leaf(false, false);  // still tilting when the tree was cut
+    } else if (s.stable && ctx_.rock_settle && n.rocks < kMaxRocks) {
+      rocking_.push_back(std::move(n));
     } else if (s.stable) {
       leaf(true, true);
     } else if (n.opt < ctx_.max_opt) {
@@ -470,6 +479,65 @@ void TreeStepper::rollStep() {
     contact_.push_back(std::move(n));
   }
   rolling_.clear();
+  addTime(ctx_.times ? &ctx_.times->first_contact : nullptr, t0);
+}
+
+
+// ---------------------------------------------------------------- rock settle (beyond the paper)
+// A pose the static test holds need not be at rest: its contacts are those within the contact
+// tolerance, so a pose released a few degrees off on a curved or domed support (peg tops, a
+// dish's underside, a rounded lip) is held where it landed, propped on contacts a millimetre
+// away. At rest, the centre of mass is at a local minimum of its height over small rolls: the
+// pose is rocked by kRockStep about the two horizontal axes of G through its centre of mass,
+// both ways, and each rock is dropped to first contact (V-A, batched), beside the unrocked pose
+// dropped the same way. When a rock lowers the centre of mass by more than kRockDrop the object
+// moves there and is tested again (a turn against the hard cap only); otherwise it is the
+// stable leaf. Its time counts as the distance step's.
+void TreeStepper::rockStep(std::vector<TreeLeaf>& leaves) {
+  const auto t0 = Clock::now();
+  const double R = ctx_.om.bounding_radius;
+  const double gap = 0.5 * ctx_.cd;
+  const double lift = R * std::sin(kRockStep) + gap;
+  constexpr int kProbes = 5;  // unrocked, then +-x, +-y
+  const Eigen::Vector3d axes[kProbes] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitX(),
+                                         Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitY()};
+  std::vector<TranslationQuery> q;
+  q.reserve(rocking_.size() * kProbes);
+  for (const TreeNode& n : rocking_) {
+    const Eigen::Vector3d com = toEigen(apply(n.X_GO, n.com_O));
+    for (int k = 0; k < kProbes; ++k) {
+      Rigid X = k == 0 ? n.X_GO : rotatedAbout(n.X_GO, com, axes[k], kRockStep);
+      X.t = X.t + v3(0, 0, lift);
+      q.push_back(TranslationQuery{X, v3(0, 0, -1), lift + gap + 0.01});
+    }
+  }
+  std::vector<double> t;
+  ctx_.backend.distance(q, t);
+  for (size_t i = 0; i < rocking_.size(); ++i) {
+    TreeNode& n = rocking_[i];
+    // Heights of the centre of mass after each drop (all rocked about the centre of mass itself).
+    double h[kProbes];
+    for (int k = 0; k < kProbes; ++k) h[k] = t[i * kProbes + k] >= kInf ? kInf : -t[i * kProbes + k];
+    int best = 0;
+    for (int k = 1; k < kProbes; ++k)
+      if (h[k] < h[best]) best = k;
+    if (h[0] >= kInf || best == 0 || h[best] > h[0] - kRockDrop) {
+      if (kTrace) {
+        double rise = kInf;
+        for (int k = 1; k < kProbes; ++k) rise = std::min(rise, h[k] - h[0]);
+        std::fprintf(stderr, "root %d at rest (rock %.1f um) rise %.1f um\n", n.root, (h[best] - h[0]) * 1e6, rise * 1e6);
+      }
+      leaves.push_back(TreeLeaf{n.X_GO, n.root, true, true, n.supported, n.quality, n.tipping_angle, n.contacts, n.path});
+      continue;
+    }
+    if (kTrace) std::fprintf(stderr, "root %d rocks %d by %.1f um\n", n.root, best, (h[0] - h[best]) * 1e6);
+    n.X_GO = translated(q[i * kProbes + best].X_GO, v3(0, 0, -t[i * kProbes + best]));
+    n.path.push_back(n.X_GO);
+    ++n.rocks;
+    ++n.turns;
+    contact_.push_back(std::move(n));
+  }
+  rocking_.clear();
   addTime(ctx_.times ? &ctx_.times->first_contact : nullptr, t0);
 }
 

@@ -230,6 +230,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("robust_min_share", &p.robust_min_share);
   r.read("robust_check", &p.robust_check);
   r.read("robust_recheck_caught", &p.robust_recheck_caught);
+  r.read("rock_settle", &p.rock_settle);
   // The budget is in seconds like every time of the ROS interface (doc/node.md, "Units"); the
   // core's field is in ms. time_budget_ms (before issue 10) is still read, with a warning.
   double budget_s = p.time_budget_ms / 1000.0;

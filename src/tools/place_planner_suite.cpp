@@ -133,6 +133,7 @@ int main(int argc, char** argv) {
     else if (a == "--robust-min-share") cfg.planner.robust_min_share = std::stod(next());
     else if (a == "--no-robust-check") cfg.planner.robust_check = false;
     else if (a == "--robust-recheck-caught") cfg.planner.robust_recheck_caught = true;
+    else if (a == "--rock-settle") cfg.planner.rock_settle = true;
     else usage(("unknown argument " + a).c_str());
   }
   if (out.empty()) usage("--out is required");

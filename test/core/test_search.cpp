@@ -298,6 +298,56 @@ TEST(Robustness, BoxNearTheEdgeOfAWallTop) {
   EXPECT_LT(checkRobustness({X_GO}, ctx, p).front().held, 12);
 }
 
+// Rock settle (TreeContext::rock_settle, PlannerConfig::rock_settle): the mug standing on the
+// dish rack's domed peg tops, released tilted 3 degrees, lands propped on pegs a millimetre away
+// (within the contact tolerance) and the static test holds it there, 3 degrees off: without the
+// rock the tilted trials fail and the pose is not robust. Rocked about its centre of mass it
+// finds lower and comes back upright, so every trial holds.
+TEST(Robustness, MugTiltedOnPegTopsRocksBackUpright) {
+  PP_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh rack = loadMesh(test::sharedData() + "/areas/dish_rack.ply");
+  const double r = 0.0014, r_area = 0.0021, cd = r_area + r_area / 1.5;
+  const ObjectModel om = buildObjectModel(mug, r);
+  const AreaModel am = buildAreaModel(rack, Eigen::Vector3d(0, 0, -1), r_area, cd, cd);
+  auto backend = makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2);
+  TreeContext ctx{om, am, *backend, StabilityParams{0.2, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2};
+  auto release = [&](bool rock, double tilt_deg) {
+    ctx.rock_settle = rock;
+    TreeStepper stepper(ctx);
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.linear() = Eigen::AngleAxisd(tilt_deg * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    X.translation() = Eigen::Vector3d(-0.207, -0.242, 0.2);  // upright over a corner's peg tops
+    stepper.addRoot(toRigid(X), 0, om.com, v3(0, 0, -1), 0.3);
+    std::vector<TreeLeaf> leaves;
+    for (int i = 0; i < 100 && !stepper.empty(); ++i) stepper.step(leaves);
+    EXPECT_EQ(leaves.size(), 1u);
+    return leaves.empty() ? TreeLeaf{} : leaves.front();
+  };
+  auto tilt = [](const TreeLeaf& l) {
+    return std::acos(std::clamp(rotate(l.X_GO, v3(0, 0, 1)).z, -1.0, 1.0)) * 180 / M_PI;
+  };
+  const TreeLeaf upright = release(true, 0);
+  ASSERT_TRUE(upright.stable) << "the mug does not stand on the peg tops";
+  EXPECT_GT(toEigen(apply(upright.X_GO, om.com)).z(), 0.1) << "not on the peg tops";
+  EXPECT_LT(tilt(upright), 1.0);
+  // Released 3 degrees off: propped where it landed without the rock, back upright with it.
+  const TreeLeaf propped = release(false, 3), rocked = release(true, 3);
+  ASSERT_TRUE(propped.stable);
+  ASSERT_TRUE(rocked.stable);
+  EXPECT_GT(tilt(propped), 2.5);
+  EXPECT_LT(tilt(rocked), 1.5);
+  // So the pose is robust with the rock, and its tilted trials fail without it.
+  RobustnessParams p;
+  p.min_share = 0;  // settle every trial, to count them
+  ctx.rock_settle = false;
+  const Robustness strict = checkRobustness({upright.X_GO}, ctx, p).front();
+  ctx.rock_settle = true;
+  const Robustness settled = checkRobustness({upright.X_GO}, ctx, p).front();
+  EXPECT_LT(strict.held, 12);
+  EXPECT_EQ(settled.held, 12);
+}
+
 TEST(Stability, WedgeNeedsSqueezeAndIsNotStable) {
   // A body held only by two vertical walls (normals +-x), nothing below: gravity needs
   // friction forces that come only from squeeze (at least weight / mu in total).

@@ -244,10 +244,12 @@ struct SearchMonitor {
     }
     // Until a robust stable pose is found, the new stable leaves are checked at once, in chunks
     // that double while none holds (1, 2, 4, 8: many trials in flight where poses keep failing,
-    // as on peg tops; one check where the first holds).
+    // as on peg tops; one check where the first holds). Bounded work: after 2 x max_candidates
+    // checks without one, the ranking checks the best of the rest (it would check them anyway).
     size_t j = 0;
-    while (j < fresh.size() && st.first_stable_ms < 0 && config.robust_check) {
-      const size_t n = std::min(fresh.size() - j, chunk);
+    const size_t max_checks = 2 * static_cast<size_t>(config.max_candidates);
+    while (j < fresh.size() && st.first_stable_ms < 0 && config.robust_check && checked.size() < max_checks) {
+      const size_t n = std::min({fresh.size() - j, chunk, max_checks - checked.size()});
       const std::vector<size_t> batch(fresh.begin() + j, fresh.begin() + j + n);
       const std::vector<Robustness> rs = robustness(batch);
       for (size_t k = 0; k < n; ++k) {
@@ -260,11 +262,14 @@ struct SearchMonitor {
       j += n;
       chunk = std::min<size_t>(2 * chunk, 8);
     }
-    for (; j < fresh.size(); ++j) {
-      if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);  // not checked: no robustness check
-      ++stable_count;
-      best_q = std::max(best_q, all[fresh[j]].quality);
-    }
+    // The rest: stable without a robustness check, or once a robust pose was found (the ranking
+    // checks them); unchecked leaves past the bound are the ranking's.
+    if (!config.robust_check || st.first_stable_ms >= 0)
+      for (; j < fresh.size(); ++j) {
+        if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);
+        ++stable_count;
+        best_q = std::max(best_q, all[fresh[j]].quality);
+      }
     st.floor_points_done = (started - open) / std::max(1, orientations);
     if (st.tree_nodes >= config.max_tree_nodes) {
       result.warnings.push_back("search stopped after max_tree_nodes = " + std::to_string(config.max_tree_nodes) +
@@ -496,6 +501,8 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   TreeSearch search(run, *models, *roots);
   search.run();
   search.rank(*roots);
+  // The first robust stable pose was found by the ranking (the search's checks were bounded).
+  if (run.st().first_stable_ms < 0 && run.result.stableCount() > 0) run.st().first_stable_ms = msSince(run.t0);
   if (run.budget > 0 && msSince(run.t0) > run.budget) run.result.timed_out = true;
   run.st().total_ms = msSince(run.t0);
   return std::move(run.result);

@@ -212,7 +212,7 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     // (tipping angle below -fall_tip) over a drop, at two poses of the tree in a row, is going
     // over a ledge. Its quasi-static walk down the ledge, facet by facet, would end where the
     // roots below it land anyway (measured: the same precision and coverage over the suite's
-    // 56 scenes, 36 % fewer nodes on books_stack), so the tree ends there, not stable. One such
+    // 56 scenes; 1963 -> 1607 nodes for the 1k mug on books_stack), so the tree ends there, not stable. One such
     // pose alone is not enough: a box released tilted lands on one edge, far past it, and
     // turns back flat.
     bool overhang = ctx_.fall_tip > 0 && !s.stable && !rolls && s.tipping_angle < -ctx_.fall_tip;

@@ -76,6 +76,19 @@ double surfaceBelow(const HeightGrid& g, double x, double y, double radius) {
   return top;
 }
 
+// The roll and rock settles' probe (rollStep, rockStep): X turned by `angle` about the horizontal
+// axis through the centre of mass com, lifted clear (R: the object's bounding radius) and
+// dropped to first contact along -z (V-A). After the drop by t the centre of mass is
+// probeRise(q, t) higher than in X (it was turned about itself).
+TranslationQuery rolledProbe(const Rigid& X, const Eigen::Vector3d& com, const Eigen::Vector3d& axis, double angle,
+                             double R, double gap) {
+  const double lift = R * std::abs(angle) + gap;
+  Rigid Y = angle == 0 ? X : rotatedAbout(X, com, axis, angle);
+  Y.t = Y.t + v3(0, 0, lift);
+  return TranslationQuery{Y, v3(0, 0, -1), lift + gap + 0.01};
+}
+double probeRise(const TranslationQuery& q, double t, double gap) { return t >= kInf ? kInf : q.tmax - gap - 0.01 - t; }
+
 void addTime(double* slot, Clock::time_point t0) {
   if (slot) *slot += msSince(t0);
 }
@@ -381,15 +394,10 @@ void TreeStepper::rollStep() {
     axes[i] = d.normalized();
     coms[i] = toEigen(apply(rolling_[i].X_GO, rolling_[i].com_O));
   }
-  // Rolled by `a` about the line through the centre of mass, lifted clear, to be dropped.
-  auto query = [&](size_t i, double a) {
-    const double lift = R * std::abs(a) + gap;
-    Rigid X = rotatedAbout(rolling_[i].X_GO, coms[i], axes[i], a);
-    X.t = X.t + v3(0, 0, lift);
-    return TranslationQuery{X, v3(0, 0, -1), lift + gap + 0.01};
-  };
-  // The centre of mass's height after the drop, relative to now (it was rolled about itself).
-  auto height = [&](const TranslationQuery& q, double t) { return t >= kInf ? kInf : q.tmax - gap - 0.01 - t; };
+  // Rolled by `a` about the line through the centre of mass, lifted clear, to be dropped; the
+  // centre of mass's height after the drop, relative to now.
+  auto query = [&](size_t i, double a) { return rolledProbe(rolling_[i].X_GO, coms[i], axes[i], a, R, gap); };
+  auto height = [&](const TranslationQuery& q, double t) { return probeRise(q, t, gap); };
   std::vector<TranslationQuery> q;
   q.reserve(rolling_.size() * kN);
   for (size_t i = 0; i < rolling_.size(); ++i)
@@ -497,7 +505,6 @@ void TreeStepper::rockStep(std::vector<TreeLeaf>& leaves) {
   const auto t0 = Clock::now();
   const double R = ctx_.om.bounding_radius;
   const double gap = 0.5 * ctx_.cd;
-  const double lift = R * std::sin(kRockStep) + gap;
   constexpr int kProbes = 5;  // unrocked, then +-x, +-y
   const Eigen::Vector3d axes[kProbes] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitX(),
                                          Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitY()};
@@ -505,19 +512,14 @@ void TreeStepper::rockStep(std::vector<TreeLeaf>& leaves) {
   q.reserve(rocking_.size() * kProbes);
   for (const TreeNode& n : rocking_) {
     const Eigen::Vector3d com = toEigen(apply(n.X_GO, n.com_O));
-    for (int k = 0; k < kProbes; ++k) {
-      Rigid X = k == 0 ? n.X_GO : rotatedAbout(n.X_GO, com, axes[k], kRockStep);
-      X.t = X.t + v3(0, 0, lift);
-      q.push_back(TranslationQuery{X, v3(0, 0, -1), lift + gap + 0.01});
-    }
+    for (int k = 0; k < kProbes; ++k) q.push_back(rolledProbe(n.X_GO, com, axes[k], k == 0 ? 0.0 : kRockStep, R, gap));
   }
   std::vector<double> t;
   ctx_.backend.distance(q, t);
   for (size_t i = 0; i < rocking_.size(); ++i) {
     TreeNode& n = rocking_[i];
-    // Heights of the centre of mass after each drop (all rocked about the centre of mass itself).
-    double h[kProbes];
-    for (int k = 0; k < kProbes; ++k) h[k] = t[i * kProbes + k] >= kInf ? kInf : -t[i * kProbes + k];
+    double h[kProbes];  // the centre of mass's height after each drop
+    for (int k = 0; k < kProbes; ++k) h[k] = probeRise(q[i * kProbes + k], t[i * kProbes + k], gap);
     int best = 0;
     for (int k = 1; k < kProbes; ++k)
       if (h[k] < h[best]) best = k;

@@ -2,6 +2,7 @@
 // stability against gravity. Each test asserts that work was done before the property.
 #include <Eigen/Geometry>
 #include <map>
+#include <memory>
 
 #include "place_planner/backend.h"
 #include "place_planner/mesh_io.h"
@@ -56,6 +57,24 @@ double minZ(const Mesh& m, const Candidate& c) {
   for (const auto& v : m.vertices) z = std::min(z, (c.X_WO * v).z());
   return z;
 }
+
+// One object over one area as the tree stepper sees it (G = W, gravity -z): the models, the CPU
+// backend and a tree context (max 5 rotations, 8 local steps, 2 threads) with the collision
+// distance r + r_area. Its members refer to each other: it is built in place, never copied.
+struct TreeScene {
+  TreeScene(const Mesh& object, const Mesh& area, double r, double r_area, double friction)
+      : cd(r + r_area),
+        om(buildObjectModel(object, r)),
+        am(buildAreaModel(area, Eigen::Vector3d(0, 0, -1), r_area, cd, cd)),
+        backend(makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2)),
+        ctx{om, am, *backend, StabilityParams{friction, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2} {}
+  TreeScene(const TreeScene&) = delete;
+  const double cd;
+  const ObjectModel om;
+  const AreaModel am;
+  const std::unique_ptr<Backend> backend;
+  TreeContext ctx;
+};
 
 }  // namespace
 
@@ -171,10 +190,7 @@ TEST(Search, MugOverTheEdgesOfBooksIsCutWhileFalling) {
   PP_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
   const Mesh books = loadMesh(test::sharedData() + "/areas/books_stack.ply");
-  const double r = 0.0015, r_area = 0.00225, cd = r + r_area;
-  const ObjectModel om = buildObjectModel(mug, r);
-  const AreaModel am = buildAreaModel(books, Eigen::Vector3d(0, 0, -1), r_area, cd, cd);
-  auto backend = makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2);
+  const TreeScene scene(mug, books, 0.0015, 0.00225, 0.2);
   struct Run {
     long nodes = 0;
     int fell = 0, stable = 0;
@@ -182,7 +198,7 @@ TEST(Search, MugOverTheEdgesOfBooksIsCutWhileFalling) {
   };
   auto run = [&](double fall_tip) {
     Run out;
-    TreeContext ctx{om, am, *backend, StabilityParams{0.2, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2};
+    TreeContext ctx = scene.ctx;
     ctx.tree_nodes = &out.nodes;
     ctx.fall_tip = fall_tip;
     TreeStepper stepper(ctx);
@@ -191,7 +207,7 @@ TEST(Search, MugOverTheEdgesOfBooksIsCutWhileFalling) {
       for (double x = -0.28; x <= 0.28; x += 0.02, ++root) {
         Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
         X.translation() = Eigen::Vector3d(x, y, 0.3);
-        stepper.addRoot(toRigid(X), root, om.com, v3(0, 0, -1), 0.5);
+        stepper.addRoot(toRigid(X), root, scene.om.com, v3(0, 0, -1), 0.5);
       }
     for (int i = 0; i < 500 && !stepper.empty(); ++i) stepper.step(out.leaves);
     EXPECT_TRUE(stepper.empty());
@@ -271,11 +287,8 @@ TEST(Search, ApproachAgainstGravityFindsNothingBelowTheTable) {
 TEST(Robustness, BoxNearTheEdgeOfAWallTop) {
   const Mesh box = scenes::box(0.06, 0.06, 0.03);  // centred on its origin
   const Mesh wall = scenes::box(0.01, 0.3, 0.1, {0, 0, -0.05});  // top at z = 0, x in +-5 mm
-  const double r = 0.0005, r_area = 0.00075, cd = r + r_area;
-  const ObjectModel om = buildObjectModel(box, r);
-  const AreaModel am = buildAreaModel(wall, Eigen::Vector3d(0, 0, -1), r_area, cd, cd);
-  auto backend = makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2);
-  const TreeContext ctx{om, am, *backend, StabilityParams{0.5, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2};
+  const TreeScene scene(box, wall, 0.0005, 0.00075, 0.5);
+  const TreeContext& ctx = scene.ctx;
   // Centre of mass at x = 3 mm: 2 mm inside the wall's edge at x = 5 mm; resting on the top.
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.translation() = Eigen::Vector3d(0.003, 0, 0.015);
@@ -307,11 +320,9 @@ TEST(Robustness, MugTiltedOnPegTopsRocksBackUpright) {
   PP_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
   const Mesh rack = loadMesh(test::sharedData() + "/areas/dish_rack.ply");
-  const double r = 0.0014, r_area = 0.0021, cd = r_area + r_area / 1.5;
-  const ObjectModel om = buildObjectModel(mug, r);
-  const AreaModel am = buildAreaModel(rack, Eigen::Vector3d(0, 0, -1), r_area, cd, cd);
-  auto backend = makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2);
-  TreeContext ctx{om, am, *backend, StabilityParams{0.2, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2};
+  TreeScene scene(mug, rack, 0.0014, 0.0021, 0.2);  // the planner's radii for the mug
+  TreeContext& ctx = scene.ctx;
+  const ObjectModel& om = scene.om;
   auto release = [&](bool rock, double tilt_deg) {
     ctx.rock_settle = rock;
     TreeStepper stepper(ctx);
@@ -380,11 +391,8 @@ TEST(Stability, ContactsFromAboveNeverHold) {
 TEST(Robustness, CaughtRuleKeepsFlatTableStrict) {
   const Mesh board = scenes::box(0.10, 0.10, 0.01);
   const Mesh table = scenes::box(0.5, 0.5, 0.02, {0, 0, -0.01});
-  const double r = 0.0005, r_area = 0.00075, cd = r + r_area;
-  const ObjectModel om = buildObjectModel(board, r);
-  const AreaModel am = buildAreaModel(table, Eigen::Vector3d(0, 0, -1), r_area, cd, cd);
-  auto backend = makeCpuBackend(om, am, TiltParams{0.002, 1e-6 + 1e-4 * r}, 2);
-  const TreeContext ctx{om, am, *backend, StabilityParams{0.5, 1.5 * cd, 3 * M_PI / 180, 0.0}, cd, 5, 8, 2};
+  const TreeScene scene(board, table, 0.0005, 0.00075, 0.5);
+  const TreeContext& ctx = scene.ctx;
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.translation() = Eigen::Vector3d(0, 0, 0.005);
   RobustnessParams p;

@@ -65,6 +65,7 @@ void validateConfig(const ValidatorConfig& c) {
   require(c.time_step > 0 && c.time_step <= 0.02, "time_step", c.time_step, "(0, 0.02] s");
   require(c.solver_iterations >= 1, "solver_iterations", c.solver_iterations, "must be >= 1");
   require(c.margin > 0, "margin", c.margin, "must be > 0");
+  require(c.world_scale >= 0.01 && c.world_scale <= 1000, "world_scale", c.world_scale, "[0.01, 1000]");
   require(c.piece_thickness >= 0, "piece_thickness", c.piece_thickness, "must be >= 0");
   require(c.piece_max_triangles >= 1, "piece_max_triangles", c.piece_max_triangles, ">= 1");
   require(c.piece_max_size > 0, "piece_max_size", c.piece_max_size, "must be > 0");
@@ -311,7 +312,7 @@ struct PhysicsValidator::Impl {
 
   std::unique_ptr<Sim> makeSim(const Eigen::Isometry3d& X_WO) const {
     auto s = std::make_unique<Sim>();
-    s->w.world.setGravity(toBt(cfg.gravity));
+    s->w.world.setGravity(toBt(Eigen::Vector3d(cfg.world_scale * cfg.gravity)));
     s->w.world.getSolverInfo().m_numIterations = cfg.solver_iterations;
     // Split impulse for every penetration (Bullet's default only below 4 cm depth, Baumgarte
     // above): position correction then adds no velocity. Measured: with the default, a 19 g
@@ -328,7 +329,7 @@ struct PhysicsValidator::Impl {
                                                 inertia);
     oi.m_friction = btScalar(cfg.friction);
     oi.m_restitution = 0.0;
-    oi.m_startWorldTransform = toBt(X_WO * Eigen::Translation3d(c_O));
+    oi.m_startWorldTransform = toBullet(X_WO * Eigen::Translation3d(c_O));
     s->body = std::make_unique<btRigidBody>(oi);
     s->body->setActivationState(DISABLE_DEACTIVATION);
     s->w.world.addRigidBody(s->body.get());
@@ -336,8 +337,20 @@ struct PhysicsValidator::Impl {
   }
 
   Eigen::Isometry3d objectPose(const btRigidBody& b) const {
-    return fromBt(b.getWorldTransform()) * Eigen::Translation3d(-c_O);
+    return fromBullet(b.getWorldTransform()) * Eigen::Translation3d(-c_O);
   }
+
+  // Poses and speeds between W (metres) and the scaled Bullet world (world_scale units per metre).
+  btTransform toBullet(Eigen::Isometry3d X) const {
+    X.translation() *= cfg.world_scale;
+    return toBt(X);
+  }
+  Eigen::Isometry3d fromBullet(const btTransform& T) const {
+    Eigen::Isometry3d X = fromBt(T);
+    X.translation() /= cfg.world_scale;
+    return X;
+  }
+  double linearSpeed(const btRigidBody& b) const { return b.getLinearVelocity().length() / cfg.world_scale; }
 };
 
 PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
@@ -350,6 +363,7 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
   Impl& d = *impl_;
   d.cfg = config;
   d.c_O = object_O.properties.center_of_mass;
+  const double S = config.world_scale;  // Bullet units per metre
 
   // Object: compound of convex pieces, body origin at c_O, axes of O.
   d.object_shape = std::make_unique<btCompoundShape>(true, static_cast<int>(object_O.triangles.size()));
@@ -366,15 +380,15 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
     // (unshrunk, a cube rested 2 mm above the table). The hull keeps its vertices only.
     std::vector<double> xyz;
     for (const auto& p : pts)
-      for (int k = 0; k < 3; ++k) xyz.push_back(p[k] - d.c_O[k]);
+      for (int k = 0; k < 3; ++k) xyz.push_back(S * (p[k] - d.c_O[k]));
     btConvexHullComputer ch;
     ch.compute(xyz.data(), 3 * sizeof(double), static_cast<int>(pts.size()),
-               btScalar(2.0 * config.margin), btScalar(0.45));
+               btScalar(2.0 * S * config.margin), btScalar(0.45));
     if (ch.vertices.size() < 4) continue;
     auto hull = std::make_unique<btConvexHullShape>();
     for (int k = 0; k < ch.vertices.size(); ++k) hull->addPoint(ch.vertices[k], false);
     hull->recalcLocalAabb();
-    hull->setMargin(btScalar(config.margin));
+    hull->setMargin(btScalar(S * config.margin));
     btTransform I;
     I.setIdentity();
     d.object_shape->addChildShape(I, hull.get());
@@ -382,21 +396,22 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
   }
   const Eigen::Vector3d ext = object_O.properties.bounds_max - object_O.properties.bounds_min;
   d.mass = config.density * std::max(ext.x(), 1e-3) * std::max(ext.y(), 1e-3) * std::max(ext.z(), 1e-3);
-  // Solid box of the bounding box's size, about its centre (taken at c_O).
-  d.inertia = btVector3(btScalar(d.mass / 12.0 * (ext.y() * ext.y() + ext.z() * ext.z())),
-                        btScalar(d.mass / 12.0 * (ext.x() * ext.x() + ext.z() * ext.z())),
-                        btScalar(d.mass / 12.0 * (ext.x() * ext.x() + ext.y() * ext.y())));
+  // Solid box of the bounding box's size, about its centre (taken at c_O), in Bullet's units.
+  d.inertia = btVector3(btScalar(S * S * d.mass / 12.0 * (ext.y() * ext.y() + ext.z() * ext.z())),
+                        btScalar(S * S * d.mass / 12.0 * (ext.x() * ext.x() + ext.z() * ext.z())),
+                        btScalar(S * S * d.mass / 12.0 * (ext.x() * ext.x() + ext.y() * ext.y())));
 
   // Area: one static BVH triangle mesh.
   d.area_triangles = std::make_unique<btTriangleMesh>(true, false);
   for (const auto& tri : area_W.triangles)
-    d.area_triangles->addTriangle(toBt(area_W.vertices[tri[0]]), toBt(area_W.vertices[tri[1]]),
-                                  toBt(area_W.vertices[tri[2]]), true);
+    d.area_triangles->addTriangle(toBt(Eigen::Vector3d(S * area_W.vertices[tri[0]])),
+                                  toBt(Eigen::Vector3d(S * area_W.vertices[tri[1]])),
+                                  toBt(Eigen::Vector3d(S * area_W.vertices[tri[2]])), true);
   d.area_shape = std::make_unique<btBvhTriangleMeshShape>(d.area_triangles.get(), true, true);
   // Measured: with the default margin 0 a cube crept 2-5 cm in 2 s on a 15 deg triangle slope at
   // mu 0.4 (tan 15 = 0.27) and stuck at mu 0.1 on the diagonal edge; with 1 mm it sticks and
   // slides exactly where tan(slope) = mu says.
-  d.area_shape->setMargin(btScalar(config.margin));
+  d.area_shape->setMargin(btScalar(S * config.margin));
 
   d.up_W = -config.gravity.normalized();
   d.area_lowest = std::numeric_limits<double>::infinity();
@@ -433,7 +448,7 @@ PoseCheck PhysicsValidator::check(const Eigen::Isometry3d& X_WO_goal,
     r.sim_time += c.time_step;
     if (c.early_accept_steps > 0) {
       const btRigidBody& b = *sim->body;
-      calm = (b.getLinearVelocity().length() < c.early_accept_linear &&
+      calm = (d.linearSpeed(b) < c.early_accept_linear &&
               b.getAngularVelocity().length() < c.early_accept_angular) ? calm + 1 : 0;
       if (calm >= c.early_accept_steps) {
         const Eigen::Isometry3d X = d.objectPose(b);
@@ -478,7 +493,7 @@ DropResult PhysicsValidator::drop(const Eigen::Isometry3d& X_WO_start) const {
     sim->w.world.stepSimulation(btScalar(c.time_step), 0);
     ++r.steps;
     const btRigidBody& b = *sim->body;
-    if (b.getLinearVelocity().length() < c.rest_linear &&
+    if (d.linearSpeed(b) < c.rest_linear &&
         b.getAngularVelocity().length() < c.rest_angular) {
       if (++calm >= c.rest_steps) {
         r.at_rest = true;
@@ -487,7 +502,7 @@ DropResult PhysicsValidator::drop(const Eigen::Isometry3d& X_WO_start) const {
     } else {
       calm = 0;
     }
-    if (d.up_W.dot(fromBt(b.getWorldTransform().getOrigin())) < d.area_lowest - c.fall_below) {
+    if (d.up_W.dot(d.fromBullet(b.getWorldTransform()).translation()) < d.area_lowest - c.fall_below) {
       r.fell_off = true;
       break;
     }

@@ -438,8 +438,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-robust-check", no_robust_check, "static stability only (the paper)");
   app.add_flag("--robust-recheck-caught", c.robust_recheck_caught,
                "robustness: tilted releases caught where they land hold if that pose holds (peg tops; costs precision)");
-  app.add_flag("--rock-settle", c.rock_settle,
-               "stable poses rocked to the bottom of their rock (racks, cups, trays: more poses, costs precision)");
+  app.add_flag("--rock-settle,!--no-rock-settle", c.rock_settle,
+               "stable poses rocked to the bottom of their rock (default on; racks, cups, trays)");
   app.add_option("--budget-ms", c.time_budget_ms, "time budget [ms], 0 = none")->check(kFinite)->capture_default_str();
   app.add_option("--max-candidates", c.max_candidates, "candidates returned")->capture_default_str();
   app.add_option("--threads", c.threads, "CPU threads, 0 = all")->capture_default_str();

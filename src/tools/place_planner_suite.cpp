@@ -48,7 +48,7 @@ double median(std::vector<double> v) {
                "  [--holes 0.05,0.1,0.2|none] [--no-fig6] [--max-validated N] [--max-drops N]\n"
                "  [--threads N] [--friction MU] [--auto-gravity] [--orientation MODE]\n"
                "  [--robust-shift M] [--robust-tilt-deg D] [--robust-com-offset F] [--robust-min-share S]\n"
-               "  [--no-robust-check] [--robust-recheck-caught]\n"
+               "  [--no-robust-check] [--robust-recheck-caught] [--no-rock-settle]\n"
                "  --auto-gravity: areas with under 5 %% of their surface facing up are planned and\n"
                "  validated with gravity against their largest flat region (area_up.h)\n",
                msg);
@@ -134,6 +134,7 @@ int main(int argc, char** argv) {
     else if (a == "--no-robust-check") cfg.planner.robust_check = false;
     else if (a == "--robust-recheck-caught") cfg.planner.robust_recheck_caught = true;
     else if (a == "--rock-settle") cfg.planner.rock_settle = true;
+    else if (a == "--no-rock-settle") cfg.planner.rock_settle = false;
     else usage(("unknown argument " + a).c_str());
   }
   if (out.empty()) usage("--out is required");

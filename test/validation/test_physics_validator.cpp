@@ -235,6 +235,26 @@ TEST(PhysicsValidator, YcbMarkerLyingOnItsHullFacetsStaysPut) {
   }
 }
 
+// The cracker box on the divided tray, default options (rock settle on): the five best stable
+// candidates stay put in Bullet. Before the wedge rule (tree_stepper.cpp, kWedgeTilt) three of
+// them were the box rocked down across a compartment onto its walls' edges, and fell in.
+TEST(PhysicsValidator, CrackerBoxInDividedTrayBestCandidatesStayPut) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh box = loadMesh(validation_test::sharedData() + "/objects/cracker_box_ycb003_1k.ply");
+  const Mesh tray = loadMesh(validation_test::sharedData() + "/areas/divided_tray.ply");
+  const PlanResult r = Planner().plan(box, tray, PlannerConfig());
+  PhysicsValidator v(box, tray, withFriction(PlannerConfig().friction));
+  int checked = 0;
+  for (const Candidate& c : r.candidates) {
+    if (!c.stable || checked == 5) continue;
+    ++checked;
+    const PoseCheck k = v.check(c.X_WO);
+    EXPECT_TRUE(k.confirmed) << "candidate at " << c.X_WO.translation().transpose() << ": moved " << k.moved_m
+                             << " m, turned " << k.turned_deg << " deg";
+  }
+  EXPECT_EQ(checked, 5);
+}
+
 // ---------------------------------------------------------------- verifyTopK (issue 9)
 
 // The cube on the built-in table, planned from the principal axis (any core: it rests on a face).

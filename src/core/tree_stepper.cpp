@@ -76,6 +76,16 @@ bool hangsBetweenEdges(const std::vector<ContactPoint>& contacts) {
   return false;
 }
 
+// A planar support whose every contact normal is within kFlatNormal of vertical: any rock about
+// the centre of mass lifts it, so the rock settle's probes are skipped (a table, a box's top).
+constexpr double kFlatNormal = 5.0 * M_PI / 180.0;
+bool flatSupport(const Stability& s, const std::vector<ContactPoint>& contacts) {
+  if (!s.planar) return false;
+  for (const ContactPoint& c : contacts)
+    if (c.n_W.z() < std::cos(kFlatNormal)) return false;
+  return true;
+}
+
 Rigid translated(Rigid X, const V3& d) {
   X.t = X.t + d;
   return X;
@@ -280,7 +290,7 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
       rotating_.push_back(std::move(n));
     } else if (line) {
       leaf(false, false);  // still tilting when the tree was cut
-    } else if (s.stable && ctx_.rock_settle && n.rocks < kMaxRocks) {
+    } else if (s.stable && ctx_.rock_settle && n.rocks < kMaxRocks && !flatSupport(s, n.contacts)) {
       rocking_.push_back(std::move(n));
     } else if (s.stable) {
       leaf(true, true);

@@ -14,7 +14,9 @@
 //    wrong static friction), each hull shrunk by the two margins so that the true surfaces touch
 //    (a cube on a table rests at its geometric height, not 2 mm above), friction mu (Bullet multiplies the two coefficients: mu x 1.0);
 //  - mass = density x bounding-box volume, centred on the mesh's centre of mass c_O (the same
-//    surface centroid the planner uses), inertia of the solid bounding box about c_O.
+//    surface centroid the planner uses), inertia of the solid bounding box about c_O;
+//  - the world simulated at `world_scale` (10) Bullet units per metre: lengths, margins and
+//    gravity scaled, times, masses and friction not; every pose and speed in this API is in W.
 #pragma once
 #include <Eigen/Geometry>
 #include <functional>

@@ -47,7 +47,7 @@ constexpr double kRockStep = 1.0 * M_PI / 180.0;
 constexpr double kRockDrop = 1e-4;
 // A rocked pose whose contacts include two steeper than kWedgeTilt from vertical, facing each
 // other (horizontal parts more than 120 degrees apart), hangs between two edges: a box lowered
-// across a tray compartment onto the rounded tops of its walls. The area's spheres round a sharp
+// across a tray compartment, its rounded edges on its walls' edges. The area's spheres round a sharp
 // edge into a cylinder of their radius (3-6 mm), Bullet's margins by 1 mm: the object sinks
 // deeper between the planner's edges, onto contacts that tilt more than Bullet's. Not at rest.
 // Measured on the 56 1k scenes with rock settle (place_planner_suite --pairs _1k@ --holes none
@@ -61,6 +61,7 @@ constexpr double kWedgeTilt = 52.0 * M_PI / 180.0;
 constexpr double kFallDrop = 0.01;
 constexpr double kFallProbe = 0.015;
 
+// The kWedgeTilt test on a rocked pose's contacts.
 bool hangsBetweenEdges(const std::vector<ContactPoint>& contacts) {
   const double c = std::cos(kWedgeTilt);
   for (size_t a = 0; a < contacts.size(); ++a) {

@@ -382,6 +382,27 @@ TEST(Robustness, MugTiltedOnPegTopsRocksBackUpright) {
   EXPECT_EQ(settled.held, 12);
 }
 
+// On a flat table a rock about the centre of mass only lifts a pose: rock settle (on by default)
+// skips such supports and leaves every candidate where the static test put it.
+TEST(Robustness, RockSettleLeavesFlatTablePosesAlone) {
+  for (const char* name : {"cube", "mug"}) {
+    const Mesh object = scenes::byName(name);
+    PlannerConfig cfg;
+    cfg.floor_point_spacing = 0.2;
+    ASSERT_TRUE(cfg.rock_settle) << "on by default";
+    const PlanResult rocked = Planner().plan(object, scenes::table(), cfg);
+    cfg.rock_settle = false;
+    const PlanResult still = Planner().plan(object, scenes::table(), cfg);
+    ASSERT_GT(rocked.stableCount(), 0) << name;
+    ASSERT_EQ(rocked.candidates.size(), still.candidates.size()) << name;
+    for (size_t i = 0; i < rocked.candidates.size(); ++i) {
+      EXPECT_EQ(rocked.candidates[i].stable, still.candidates[i].stable) << name << " " << i;
+      EXPECT_LT((rocked.candidates[i].X_WO.translation() - still.candidates[i].X_WO.translation()).norm(), 1e-9)
+          << name << " " << i;
+    }
+  }
+}
+
 TEST(Stability, WedgeNeedsSqueezeAndIsNotStable) {
   // A body held only by two vertical walls (normals +-x), nothing below: gravity needs
   // friction forces that come only from squeeze (at least weight / mu in total).

@@ -82,8 +82,9 @@ bool hangsBetweenEdges(const std::vector<ContactPoint>& contacts) {
 constexpr double kFlatNormal = 5.0 * M_PI / 180.0;
 bool flatSupport(const Stability& s, const std::vector<ContactPoint>& contacts) {
   if (!s.planar) return false;
+  const double up = std::cos(kFlatNormal);
   for (const ContactPoint& c : contacts)
-    if (c.n_W.z() < std::cos(kFlatNormal)) return false;
+    if (c.n_W.z() < up) return false;
   return true;
 }
 
@@ -529,7 +530,6 @@ void TreeStepper::rollStep() {
   rolling_.clear();
   addTime(ctx_.times ? &ctx_.times->first_contact : nullptr, t0);
 }
-
 
 // ---------------------------------------------------------------- rock settle (beyond the paper)
 // A pose the static test holds need not be at rest: its contacts are those within the contact

@@ -32,6 +32,9 @@ struct HeightGrid {
   std::vector<int> start;    // nx * ny + 1 offsets into items
   std::vector<int> items;    // area sphere indices, each cell's highest first
   std::vector<double> max_z; // per cell; -inf when empty
+  // Per cell: the highest object sphere centre that can make a contact there (sphereContact:
+  // within contact_gap of an area sphere's plane and over its patch); -inf when empty.
+  std::vector<double> max_contact_z;
 };
 
 struct MeshModel {

@@ -97,6 +97,15 @@ HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, 
   g.ny = std::max(1, static_cast<int>(std::ceil((bounds.hi.y - bounds.lo.y + 2 * cd) / cell)));
   const size_t ncell = static_cast<size_t>(g.nx) * g.ny;
   g.max_z.assign(ncell, -std::numeric_limits<double>::infinity());
+  g.max_contact_z = g.max_z;
+  // How high above an area sphere an object sphere centre can make a contact (sphereContact):
+  // within contact_gap along the sphere's normal n and 1.5 r across it, so at most
+  // contact_gap |n_z| + 1.5 r sqrt(1 - n_z^2) higher, and within cd. Over a flat support that is
+  // the contact gap, not cd: the spheres hovering a few millimetres above it cost a lookup only.
+  auto reach = [&](size_t i) {
+    const double nz = std::min(1.0, std::abs(s.normals[i].z));
+    return std::min(cd, g.contact_gap * nz + 1.5 * s.radius * std::sqrt(1.0 - nz * nz)) + 1e-9;
+  };
   std::vector<int> count(ncell, 0);
   // Cells meeting the virtual sphere's x/y disc (radius cd), restricted to the rows [r0, r1).
   auto forCells = [&](const V3& c, int r0, int r1, auto&& f) {
@@ -138,6 +147,7 @@ HeightGrid buildHeightGrid(const SphereModel& s, const Aabb& bounds, double cd, 
       forCells(s.centres[i], r0, r1, [&](size_t k) {
         g.items[fill[k]++] = static_cast<int>(i);
         g.max_z[k] = std::max(g.max_z[k], s.centres[i].z + cd);  // "max z plus collision distance"
+        g.max_contact_z[k] = std::max(g.max_contact_z[k], s.centres[i].z + reach(i));
       });
     }
   });

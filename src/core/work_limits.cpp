@@ -57,7 +57,7 @@ double estimateModelBytes(const Mesh& mesh, double r, double cd, double cell, si
     // Any horizontal extent: the grid spans the two largest.
     double e[3] = {ext.x(), ext.y(), ext.z()};
     std::sort(e, e + 3);
-    bytes += (e[2] + 2 * cd) / cell * ((e[1] + 2 * cd) / cell) * 16.0;
+    bytes += (e[2] + 2 * cd) / cell * ((e[1] + 2 * cd) / cell) * 24.0;  // offset, two heights
   }
   return bytes;
 }

@@ -5,6 +5,7 @@
 #include "place_planner/backend.h"
 #include "place_planner/contact_points.h"
 #include "place_planner/floor_points.h"
+#include "place_planner/kernels/batched_steps.h"
 #include "place_planner/kernels/geometry.h"
 #include "place_planner/planner.h"
 #include "place_planner/pre_orientation.h"
@@ -261,6 +262,54 @@ TEST(SphereModel, SpacingAndGridHeights) {
   // Every non-empty cell's height is the plane plus the collision distance.
   for (size_t k = 0; k < am.grid.max_z.size(); ++k)
     if (am.grid.start[k + 1] > am.grid.start[k]) EXPECT_NEAR(am.grid.max_z[k], 0.01, 1e-12);
+}
+
+// The contact height cull (HeightGrid::max_contact_z, in gridMayCollide and sphereContact) drops
+// only object spheres that make no contact: the contacts of poses touching and hovering up to
+// 4 mm above pegs, a box's walls and binder edges are those of every object sphere tested with
+// the collision-distance height alone (max_z).
+TEST(SphereModel, ContactHeightCullKeepsEveryContact) {
+  auto host = [](const auto& v) { return v.empty() ? nullptr : v.data(); };  // views of host arrays
+  const Mesh object = scenes::mug();
+  const ObjectModel om = buildObjectModel(object, 0.0015);
+  const ObjectView ov = makeObjectView(om, host);
+  int contacts = 0, culled = 0;
+  for (const Mesh& area : {scenes::dishRack(), scenes::openBox(), scenes::binderStack()}) {
+    const AreaModel am = buildAreaModel(area, {0, 0, -1}, 0.003, 0.005, 0.005);
+    const AreaView av = makeAreaView(am, host);
+    AreaView reference = av;
+    reference.grid.max_contact_z = reference.grid.max_z;  // cull by the collision distance only
+    const V3 mid = 0.5 * (am.bounds.lo + am.bounds.hi);
+    for (int k = 0; k < 40; ++k) {
+      // Tilted up to 40 degrees about a horizontal axis, over a spiral of points on the area.
+      const double a = 0.7 * k, rad = 0.004 * k;
+      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+      X.linear() = Eigen::AngleAxisd(M_PI / 180 * (k % 5) * 10, Eigen::Vector3d(std::cos(a), std::sin(a), 0)).toRotationMatrix();
+      X.translation() = Eigen::Vector3d(mid.x + rad * std::cos(a), mid.y + rad * std::sin(a), am.bounds.hi.z + 0.2);
+      const double t = firstContactDistance(ov, av, toRigid(X), v3(0, 0, -1), 1.0);
+      if (t >= kInf) continue;
+      for (double up : {0.0, 0.0002, 0.001, 0.004}) {
+        Rigid T = toRigid(X);
+        T.t = T.t + v3(0, 0, up - t);
+        const V3 com = apply(T, ov.com);
+        std::vector<int> kept, all;
+        forEachSphereNearArea(ov, av, T, [&](int s) {
+          if (sphereContact(av, apply(T, ov.mesh.sphere_centres[s]), rotate(T, ov.mesh.sphere_normals[s]), com).valid)
+            kept.push_back(s);
+        });
+        for (int s = 0; s < ov.mesh.num_spheres; ++s) {
+          const SphereContact c = sphereContact(reference, apply(T, ov.mesh.sphere_centres[s]), rotate(T, ov.mesh.sphere_normals[s]), com);
+          if (c.valid) all.push_back(s);
+        }
+        std::sort(kept.begin(), kept.end());
+        ASSERT_EQ(kept, all) << "pose " << k << " lifted " << up;
+        contacts += static_cast<int>(all.size());
+      }
+    }
+    for (size_t c = 0; c < am.grid.max_z.size(); ++c) culled += am.grid.max_contact_z[c] < am.grid.max_z[c] - 1e-3;
+  }
+  EXPECT_GT(contacts, 1000);  // the poses touch
+  EXPECT_GT(culled, 1000);    // and the cull is tighter than the collision distance in most cells
 }
 
 // L-shaped prism: the cross-section has one reflex corner at (1, 1), whose vertical edge

@@ -319,7 +319,8 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   const int iy = static_cast<int>(floor((s_G.y - g.y0) / g.cell));
   if (ix < 0 || iy < 0 || ix >= g.nx || iy >= g.ny) return out;
   const int cell = iy * g.nx + ix;
-  if (s_G.z > g.max_z[cell]) return out;  // early out: above everything in this cell
+  // Early out: above every height in this cell from which a contact can be made.
+  if (s_G.z > g.max_contact_z[cell]) return out;
   const double cd2 = g.collision_distance * g.collision_distance;
   V3 sum = v3(0, 0, 0), nsum = v3(0, 0, 0);
   int count = 0;
@@ -358,9 +359,9 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   return out;
 }
 
-// Can a sphere centre inside box b (frame G) collide with an area sphere? Only when b reaches
-// below the maximum height (plus collision distance) of a grid cell under it. Boxes over more
-// than 64 cells are not tested: their children are.
+// Can a sphere centre inside box b (frame G) make a contact (sphereContact)? Only when b
+// reaches below the highest contact height (max_contact_z) of a grid cell under it. Boxes over
+// more than 64 cells are not tested: their children are.
 PP_HD bool gridMayCollide(const GridView& g, const Aabb& b) {
   const double fx0 = floor((b.lo.x - g.x0) / g.cell), fx1 = floor((b.hi.x - g.x0) / g.cell);
   const double fy0 = floor((b.lo.y - g.y0) / g.cell), fy1 = floor((b.hi.y - g.y0) / g.cell);
@@ -371,7 +372,7 @@ PP_HD bool gridMayCollide(const GridView& g, const Aabb& b) {
   if ((ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 64) return true;
   for (int iy = iy0; iy <= iy1; ++iy)
     for (int ix = ix0; ix <= ix1; ++ix)
-      if (b.lo.z <= g.max_z[iy * g.nx + ix]) return true;
+      if (b.lo.z <= g.max_contact_z[iy * g.nx + ix]) return true;
   return false;
 }
 

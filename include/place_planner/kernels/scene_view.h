@@ -29,6 +29,7 @@ struct GridView {
   const int* start;
   const int* items;
   const double* max_z;
+  const double* max_contact_z;
 };
 
 struct ObjectView {

@@ -235,13 +235,18 @@ struct SearchMonitor {
 
   bool afterStep(std::vector<TreeLeaf>& all, int started, int open) {
     PlanStats& st = result.stats;
+    // Penetration guard: an object inside the area by more than a sphere radius is not stable
+    // (the new stable leaves tested on the pool).
     std::vector<size_t> fresh;
-    for (; seen < all.size(); ++seen) {
-      TreeLeaf& l = all[seen];
-      // Penetration guard: an object inside the area by more than a sphere radius is not stable.
-      if (l.stable && penetrationDepth(om, am, l.X_GO) > penetration_limit) l.stable = false;
-      if (l.stable) fresh.push_back(seen);
-    }
+    for (; seen < all.size(); ++seen)
+      if (all[seen].stable) fresh.push_back(seen);
+    std::vector<char> inside(fresh.size(), 0);
+    parallelFor(fresh.size(), config.threads, [&](size_t k) {
+      inside[k] = penetrationDepth(om, am, all[fresh[k]].X_GO) > penetration_limit;
+    });
+    for (size_t k = 0; k < fresh.size(); ++k)
+      if (inside[k]) all[fresh[k]].stable = false;
+    fresh.erase(std::remove_if(fresh.begin(), fresh.end(), [&](size_t i) { return !all[i].stable; }), fresh.end());
     // Until a robust stable pose is found, the new stable leaves are checked at once, in chunks
     // that double while none holds (1, 2, 4, 8: many trials in flight where poses keep failing,
     // as on peg tops; one check where the first holds). Bounded work: after 2 x max_candidates

@@ -31,6 +31,7 @@ constexpr int kMaxRocks = 8;  // rock settle steps per tree
 constexpr int kRollSteps = 8;
 constexpr double kRollStep = 3.0 * M_PI / 180.0;
 constexpr int kRollFine = 2;  // 1 degree
+constexpr int kRollNear = 4;  // coarse steps dropped in the first round
 constexpr double kMaxRollAxisSlope = 0.34;  // sin 20 degrees
 // The bottom of a roll holds when the crests either way rise at least this (m) above it; a
 // lower crest does not hold a release and the roll goes on over it. Measured (Bullet in its
@@ -443,15 +444,43 @@ void TreeStepper::rollStep() {
   q.reserve(rolling_.size() * kN);
   for (size_t i = 0; i < rolling_.size(); ++i)
     for (int k = -kRollSteps; k <= kRollSteps; ++k) q.push_back(query(i, k * kRollStep));
-  std::vector<double> t;
-  ctx_.backend.distance(q, t);
+  // The coarse rolls are dropped in two rounds: those within kRollNear steps first, the rest
+  // only for the poses whose walk or crests reach past them (most bottoms and crests are near).
+  // The decisions read the same heights either way: the result is that of one full round.
+  std::vector<double> t(q.size(), kInf);
+  std::vector<char> known(q.size(), 0);
+  auto drop = [&](const std::vector<size_t>& which) {
+    std::vector<TranslationQuery> sub;
+    sub.reserve(which.size());
+    for (size_t k : which) sub.push_back(q[k]);
+    std::vector<double> ts;
+    ctx_.backend.distance(sub, ts);
+    for (size_t j = 0; j < which.size(); ++j) t[which[j]] = ts[j], known[which[j]] = 1;
+  };
+  {
+    std::vector<size_t> near;
+    for (size_t i = 0; i < rolling_.size(); ++i)
+      for (int j = kRollSteps - kRollNear; j <= kRollSteps + kRollNear; ++j) near.push_back(i * kN + j);
+    drop(near);
+  }
 
   std::vector<int> bottom(rolling_.size(), -1);  // coarse bottom of the bracketed ones
   std::vector<char> keep(rolling_.size(), 0);     // 0: nothing below any roll (falls off)
-  for (size_t i = 0; i < rolling_.size(); ++i) {
+  // Pose i's bottom and margin; false (nothing changed) when a height it needs is not known yet.
+  auto decide = [&](size_t i) {
     TreeNode& n = rolling_[i];
-    double h[kN];
-    for (int j = 0; j < kN; ++j) h[j] = height(q[i * kN + j], t[i * kN + j]);
+    bool unknown = false;
+    double hv[kN];
+    for (int j = 0; j < kN; ++j) hv[j] = height(q[i * kN + j], t[i * kN + j]);
+    struct Heights {  // every height the decisions read, noting one not dropped yet
+      const double* v;
+      const char* k;
+      bool* unknown;
+      double operator[](int j) const {
+        if (!k[j]) *unknown = true;
+        return v[j];
+      }
+    } h{hv, &known[i * kN], &unknown};
     // Downhill from where it lies (a crest lower than kMinRollRise does not hold a release: it
     // rolls over into the next valley): the bottom of its own valley, not the lowest of the range.
     int best = kRollSteps;
@@ -467,8 +496,8 @@ void TreeStepper::rollStep() {
         if (moved) break;
       }
     }
-    if (h[best] >= kInf) continue;  // nothing below: it falls off the area
-    keep[i] = 1;
+    if (unknown) return false;
+    if (h[best] >= kInf) return true;  // nothing below: it falls off the area
     // Each way: the crest, the highest rise before the roll descends by more than kMinRollRise
     // or below the bottom (lower crests are dents it passes over), and the roll to it.
     auto crest = [&](int dir) {
@@ -481,6 +510,8 @@ void TreeStepper::rollStep() {
       return Crest{std::abs(top - best) * kRollStep, h[top] - h[best], true};
     };
     const Crest cp = crest(1), cm = crest(-1);
+    if (unknown) return false;
+    keep[i] = 1;
     // Not bracketed (the lowest roll at the end of the range, or a side still rising but less
     // than kMinRollRise where the range ends): roll on from the lowest pose, the range centred
     // on it. Centred already, the range is what is known.
@@ -496,7 +527,16 @@ void TreeStepper::rollStep() {
       n.roll_margin = std::min(margin(cp), margin(cm));
       bottom[i] = best;
     }
-  }
+    return true;
+  };
+  std::vector<size_t> later, far;
+  for (size_t i = 0; i < rolling_.size(); ++i)
+    if (!decide(i)) later.push_back(i);
+  for (size_t i : later)
+    for (int j = 0; j < kN; ++j)
+      if (!known[i * kN + j]) far.push_back(i * kN + j);
+  if (!far.empty()) drop(far);
+  for (size_t i : later) decide(i);
   // The bracketed bottoms refined: the fine rolls within a coarse step either side.
   std::vector<TranslationQuery> fq;
   std::vector<size_t> fi;

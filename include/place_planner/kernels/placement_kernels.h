@@ -175,10 +175,14 @@ struct TiltParams {
 // Angle of an object-frame rotation sigma*theta (sigma = +1 ccw, -1 cw) from a ccw angle.
 PP_HD double directed(double ccw, int sigma) { return sigma > 0 ? ccw : wrapAngle(kTwoPi - ccw); }
 
-// Box of everything a BVH node's box (already in the frame of the axis) sweeps over a window.
-PP_HD Aabb arcNodeBox(const Aabb& nb, V3 s, V3 d, const AngleWindow& w) {
+// Box of everything a BVH node's box (in its mesh's frame; X maps it into the frame of the axis)
+// sweeps over a window: the arc of its centre, inflated by its half diagonal. A rotation keeps
+// every point of the box within that distance of the centre, so the centre is mapped and the
+// box is not (its mapped axis-aligned box would be up to sqrt 3 wider).
+template <bool kInverse>
+PP_HD Aabb arcNodeBox(const Rigid& X, const Aabb& nb, V3 s, V3 d, const AngleWindow& w) {
   const V3 c = 0.5 * (nb.lo + nb.hi);
-  return aabbInflate(arcBoxW(c, s, d, w), 0.5 * norm(nb.hi - nb.lo));
+  return aabbInflate(arcBoxW(kInverse ? applyInv(X, c) : apply(X, c), s, d, w), 0.5 * norm(nb.hi - nb.lo));
 }
 
 struct VertexArc {
@@ -221,7 +225,7 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
     const AngleWindow win = angleWindow(a0, sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         om.vertex_bvh, am.triangle_bvh,
-        [&](const BvhNode& n) { return arcNodeBox(transformBox(X_GO, n.box), s_A, d_A, win); },
+        [&](const BvhNode& n) { return arcNodeBox<false>(X_GO, n.box, s_A, d_A, win); },
         [&](int vi) {
           const V3 v = apply(X_GO, om.vertices[vi]);
           return VertexArc{v, aabbInflate(arcBoxW(v, s_A, d_A, win), tp.tol)};
@@ -241,7 +245,7 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
     const AngleWindow win_area = angleWindow(-a0, -sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         am.vertex_bvh, om.triangle_bvh,
-        [&](const BvhNode& n) { return arcNodeBox(transformBoxInv(X_GO, n.box), s_O, d_O, win_area); },
+        [&](const BvhNode& n) { return arcNodeBox<true>(X_GO, n.box, s_O, d_O, win_area); },
         [&](int wi) {
           const V3 w = applyInv(X_GO, am.vertices[wi]);
           return VertexArc{w, aabbInflate(arcBoxW(w, s_O, d_O, win_area), tp.tol)};
@@ -276,7 +280,7 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
         angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         om.edge_bvh, am.edge_bvh,
-        [&](const BvhNode& n) { return arcNodeBox(transformBox(X_GO, n.box), s_A, d_A, win); },
+        [&](const BvhNode& n) { return arcNodeBox<false>(X_GO, n.box, s_A, d_A, win); },
         [&](int ei) {
           const int* e = om.edges + 2 * ei;
           const V3 p0 = apply(X_GO, om.vertices[e[0]]), p1 = apply(X_GO, om.vertices[e[1]]);

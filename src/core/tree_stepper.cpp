@@ -548,9 +548,15 @@ void TreeStepper::rollStep() {
       fi.push_back(i);
     }
   }
-  std::vector<double> ft;
-  if (!fq.empty()) ctx_.backend.distance(fq, ft);
+  // The middle fine roll is the coarse bottom, dropped already.
   constexpr int kF = 2 * kRollFine + 1;
+  std::vector<TranslationQuery> send;
+  for (size_t f = 0; f < fq.size(); ++f)
+    if (f % kF != kRollFine) send.push_back(fq[f]);
+  std::vector<double> st, ft(fq.size());
+  if (!send.empty()) ctx_.backend.distance(send, st);
+  for (size_t f = 0, j = 0; f < fq.size(); ++f)
+    ft[f] = f % kF == kRollFine ? t[fi[f] * kN + bottom[fi[f]]] : st[j++];
   for (size_t i = 0, f = 0; i < rolling_.size(); ++i) {
     if (bottom[i] < 0) continue;
     int best = kRollFine;  // the coarse bottom itself

@@ -19,6 +19,9 @@ struct RankingInput {
   double object_radius = 0;   // m, bounding radius (contact summaries)
   Eigen::Vector3d com_O = Eigen::Vector3d::Zero();  // object's centre of mass (kLowest)
   std::vector<size_t> robust_leaves = {};  // leaves the search already found robust (kept when merging)
+  // True once a cancel or the budget has cut the plan: the robust leaves above stay robust even
+  // where the ranking's own checks did not reach them.
+  std::function<bool()> cut = {};
 };
 
 // Robustness of the leaves given by index (robustness.h); called on the best stable leaves

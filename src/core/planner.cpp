@@ -454,6 +454,7 @@ class TreeSearch {
     RankingInput in{leaves_, kinds, floor_W, m_.am->R_GW, r.R_held_G, props.bounding_radius, props.center_of_mass};
     for (const auto& [leaf, rb] : monitor_.checked)
       if (rb.share() >= config.robust_min_share - 1e-9) in.robust_leaves.push_back(leaf);
+    in.cut = [this] { return run_.result.cancelled || run_.result.timed_out; };
     const PlaceabilityContext pc{m_.om, *m_.am, *m_.backend, m_.d_vis, config};
     run_.result.candidates = rankCandidates(
         in, config, [&](const std::vector<size_t>& idx) { return monitor_.robustnessOf(idx); }, &run_.st(),

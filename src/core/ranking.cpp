@@ -138,6 +138,25 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
         robust += ok;
       }
     }
+    // Cut by a cancel or the budget, the checks above may end before the leaves the search found
+    // robust: those stay robust (their results are the search's, not checked again), so what was
+    // found is returned.
+    std::vector<size_t> found, where;
+    const bool cut = in.cut && in.cut();
+    for (size_t k = 0; k < distinct.size() && cut; ++k)
+      if (distinct[k].stable && !distinct[k].checked && robustAlready(distinct[k].leaf) && placeable(distinct[k])) {
+        found.push_back(distinct[k].leaf);
+        where.push_back(k);
+      }
+    if (!found.empty()) {
+      const std::vector<Robustness> rs = check(found);
+      for (size_t j = 0; j < where.size(); ++j) {
+        Item& it = distinct[where[j]];
+        it.robustness = rs[j];
+        it.checked = rs[j].trials > 0;
+        it.stable = it.checked && rs[j].share() >= config.robust_min_share - 1e-9;
+      }
+    }
     // Stable leaves never checked (out of time, or beyond the candidates needed) are not
     // claimed stable.
     for (Item& it : distinct)

@@ -112,6 +112,13 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
   };
   // Robustness, best stable first, until max_candidates robust ones are found.
   if (config.robust_check && check) {
+    // A leaf's robustness decides its stable flag; true when it holds.
+    auto record = [&](Item& it, const Robustness& r) {
+      it.robustness = r;
+      it.checked = r.trials > 0;
+      it.stable = it.checked && r.share() >= config.robust_min_share - 1e-9;
+      return it.stable;
+    };
     int robust = 0, checked = 0;
     size_t next = 0;
     // Bounded work: at most four times max_candidates leaves are checked.
@@ -127,14 +134,11 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
       checked += static_cast<int>(batch.size());
       for (size_t j = 0; j < where.size(); ++j) {
         Item& it = distinct[where[j]];
-        it.robustness = rs[j];
-        it.checked = rs[j].trials > 0;
-        const bool ok = it.checked && rs[j].share() >= config.robust_min_share - 1e-9;
+        const bool ok = record(it, rs[j]);
         if (stats) {
           stats->robustness_checked += it.checked;
           stats->robustness_rejected += !ok;
         }
-        it.stable = ok;
         robust += ok;
       }
     }
@@ -150,12 +154,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
       }
     if (!found.empty()) {
       const std::vector<Robustness> rs = check(found);
-      for (size_t j = 0; j < where.size(); ++j) {
-        Item& it = distinct[where[j]];
-        it.robustness = rs[j];
-        it.checked = rs[j].trials > 0;
-        it.stable = it.checked && rs[j].share() >= config.robust_min_share - 1e-9;
-      }
+      for (size_t j = 0; j < where.size(); ++j) record(distinct[where[j]], rs[j]);
     }
     // Stable leaves never checked (out of time, or beyond the candidates needed) are not
     // claimed stable.

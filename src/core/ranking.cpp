@@ -6,6 +6,7 @@
 
 #include "place_planner/contact_points.h"
 #include "place_planner/placeability.h"
+#include "place_planner/stable_sort.h"
 
 namespace place_planner {
 namespace {
@@ -30,7 +31,7 @@ struct Item {
 long quantised(double v, double step) { return std::lround(v / step); }
 
 void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
-  std::stable_sort(items.begin(), items.end(), [&](const Item& a, const Item& b) {
+  stableSortAligned(items, [&](const Item& a, const Item& b) {
     if (a.stable != b.stable) return a.stable;
     if (a.preference != b.preference) return a.preference < b.preference;
     const long sa = quantised(a.score(), 1e-3), sb = quantised(b.score(), 1e-3);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "place_planner/parallel_for.h"
+#include "place_planner/stable_sort.h"
 
 namespace place_planner {
 namespace validation {
@@ -578,8 +579,7 @@ VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerCo
     if (!c.stable) return 2;
     return c.physics.checked && !c.physics.stayed ? 1 : 0;
   };
-  std::stable_sort(cands.begin(), cands.end(),
-                   [&](const Candidate& a, const Candidate& b) { return group(a) < group(b); });
+  stableSortAligned(cands, [&](const Candidate& a, const Candidate& b) { return group(a) < group(b); });
   s.demoted = s.checked - s.stayed;
   s.total_ms = msSince(t0);
   return s;

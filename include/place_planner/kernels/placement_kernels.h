@@ -44,8 +44,15 @@ PP_HD double boxVolume(const Aabb& b) {
 // leaf(data, primitive of A, primitive of B). Replaces one root-to-leaf query per primitive
 // of A (the paper's kd-restart per ray) by one walk over both trees.
 constexpr int kPairStack = 2 * kBvhStack;
-template <typename BoxA, typename Prep, typename Leaf>
-PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& prep, Leaf&& leaf) {
+struct AnyOrder {  // children visited in tree order
+  PP_HD bool operator()(const Aabb&, const Aabb&) const { return false; }
+};
+// nearer(x, y): visit the pair with box x before the one with box y (both of A's mapped boxes
+// or both of B's): a query whose reach shrinks with its hits (the translation to first
+// contact) finds its nearest hit sooner and prunes more.
+template <typename BoxA, typename Prep, typename Leaf, typename NearerA = AnyOrder, typename NearerB = AnyOrder>
+PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& prep, Leaf&& leaf,
+                        NearerA nearerA = {}, NearerB nearerB = {}) {
   if (A.num_nodes == 0 || B.num_nodes == 0) return;
   // Each entry carries A's mapped box, so a node of A is mapped once per split, not once per
   // node of B it meets. Pairs are pushed only when their boxes overlap.
@@ -91,13 +98,23 @@ PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& 
       continue;
     }
     // Both trees are at most kBvhStack / 2 deep, so this stack cannot overflow.
+    // The pair to visit first is pushed last.
     if (lb || boxVolume(p.box) >= boxVolume(nb.box)) {
-      for (const int c : {na.right, na.left}) {
-        const Aabb cb = boxA(A.nodes[c]);
-        if (aabbOverlap(cb, nb.box)) stack[top++] = Pair{c, p.b, cb};
+      Aabb cb[2] = {boxA(A.nodes[na.right]), boxA(A.nodes[na.left])};
+      int c[2] = {na.right, na.left};
+      if (nearerA(cb[0], cb[1])) {
+        const Aabb t = cb[0];
+        cb[0] = cb[1];
+        cb[1] = t;
+        const int u = c[0];
+        c[0] = c[1];
+        c[1] = u;
       }
+      for (int k = 0; k < 2; ++k)
+        if (aabbOverlap(cb[k], nb.box)) stack[top++] = Pair{c[k], p.b, cb[k]};
     } else {
-      for (const int c : {nb.right, nb.left})
+      const bool swap = nearerB(B.nodes[nb.right].box, B.nodes[nb.left].box);
+      for (const int c : {swap ? nb.left : nb.right, swap ? nb.right : nb.left})
         if (aabbOverlap(p.box, B.nodes[c].box)) stack[top++] = Pair{p.a, c, p.box};
     }
   }
@@ -120,13 +137,15 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
   auto swept = [&](const BvhNode& n) { return sweepBox(transformBox(X_GO, n.box), d, best); };
+  // Moving along u: the moving part foremost along u and the fixed part hindmost first.
+  auto ahead = [](V3 u) { return [u](const Aabb& x, const Aabb& y) { return dot(x.lo + x.hi, u) > dot(y.lo + y.hi, u); }; };
   // Object vertices along d against area triangles.
   auto posed = [&](int vi) { return apply(X_GO, om.vertices[vi]); };
   dualTraverse(om.vertex_bvh, am.triangle_bvh, swept, posed, [&](const V3& v, int, int t) {
     const int* tri = am.triangles + 3 * t;
     const double h = rayTriangle(v, d, am.vertices[tri[0]], am.vertices[tri[1]], am.vertices[tri[2]]);
     if (h < best) best = h;
-  });
+  }, ahead(d), ahead(-d));
   // Object edges against area edges.
   auto posedEdge = [&](int ei) {
     const int* e = om.edges + 2 * ei;
@@ -139,7 +158,7 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
     if (!aabbOverlap(sweepBox(segmentBox(p0, p1), d, best), segmentBox(q0, q1))) return;
     const double h = edgeEdgeTranslation(p0, p1, q0, q1, d);
     if (h < best) best = h;
-  });
+  }, ahead(d), ahead(-d));
   // Area vertices moving by -d against the object's triangles, in O.
   const V3 dir_O = -rotateInv(X_GO, d);
   auto swept_area = [&](const BvhNode& n) {
@@ -150,7 +169,7 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
     const int* tri = om.triangles + 3 * t;
     const double h = rayTriangle(w, dir_O, om.vertices[tri[0]], om.vertices[tri[1]], om.vertices[tri[2]]);
     if (h < best) best = h;
-  });
+  }, ahead(dir_O), ahead(-dir_O));
   return best < tmax ? best : kInf;
 }
 

@@ -240,8 +240,9 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
   };
   for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
     // The window ends at the best angle so far: arcs past it cannot give a smaller one.
+    // It also shrinks with every nearer hit, so the arcs of the nodes met after it are shorter.
     const double a0 = sigma * angleWindowStart(k);
-    const AngleWindow win = angleWindow(a0, sigma * minv(angleWindowEnd(k), best));
+    AngleWindow win = angleWindow(a0, sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         om.vertex_bvh, am.triangle_bvh,
         [&](const BvhNode& n) { return arcNodeBox<false>(X_GO, n.box, s_A, d_A, win); },
@@ -258,10 +259,12 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
           if (!aabbOverlap(va.box, tb)) return;
           double out[2];
           const int m = vertexTriangleAngles(v, s_A, d_A, A, B, C, tp.tol, out);
+          const double before = best;
           for (int j = 0; j < m; ++j) accept(out[j], sigma, v, am.triangle_normals[t], A, s_A, d_A);
+          if (best < before) win = angleWindow(a0, sigma * minv(angleWindowEnd(k), best));
         });
     if (best <= angleWindowStart(k)) break;
-    const AngleWindow win_area = angleWindow(-a0, -sigma * minv(angleWindowEnd(k), best));
+    AngleWindow win_area = angleWindow(-a0, -sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         am.vertex_bvh, om.triangle_bvh,
         [&](const BvhNode& n) { return arcNodeBox<true>(X_GO, n.box, s_O, d_O, win_area); },
@@ -278,7 +281,9 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
           if (!aabbOverlap(va.box, tb)) return;
           double out[2];
           const int m = vertexTriangleAngles(w, s_O, d_O, A, B, C, tp.tol, out);
+          const double before = best;
           for (int j = 0; j < m; ++j) accept(out[j], -sigma, w, om.triangle_normals[t], A, s_O, d_O);
+          if (best < before) win_area = angleWindow(-a0, -sigma * minv(angleWindowEnd(k), best));
         });
   }
   return best < limit ? best : kInf;
@@ -295,8 +300,8 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
   const AxisFrame frame = axisFrame(s_A, d_A);
   const double max_angle = angleWindowEnd(kNumAngleWindows - 1);
   for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
-    const AngleWindow win =
-        angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best));
+    // The window ends at the best angle so far, and shrinks with every nearer hit.
+    AngleWindow win = angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best));
     dualTraverse(
         om.edge_bvh, am.edge_bvh,
         [&](const BvhNode& n) { return arcNodeBox<false>(X_GO, n.box, s_A, d_A, win); },
@@ -314,10 +319,13 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
           if (!aabbOverlap(ea.box, segmentBox(q0, q1))) return;
           double out[4];
           const int m = edgeEdgeAnglesAxis(ea.P0, ea.P1, toAxis(frame, q0), toAxis(frame, q1), out);
+          const double before = best;
           for (int q = 0; q < m; ++q) {
             const double th = directed(out[q], sigma);
             if (th > tp.min_angle && th < best && th <= max_angle) best = th;
           }
+          if (best < before)
+            win = angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best));
         });
   }
   return best < limit ? best : kInf;

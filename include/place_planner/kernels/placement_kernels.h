@@ -50,27 +50,41 @@ struct AnyOrder {  // children visited in tree order
 // nearer(x, y): visit the pair with box x before the one with box y (both of A's mapped boxes
 // or both of B's): a query whose reach shrinks with its hits (the translation to first
 // contact) finds its nearest hit sooner and prunes more.
-template <typename BoxA, typename Prep, typename Leaf, typename NearerA = AnyOrder, typename NearerB = AnyOrder>
+// reach(): how far the query still reaches (the best distance so far); a pair pushed when it
+// reached farther gets its box mapped again when it comes off the stack, so pairs the hits
+// found since have put out of reach are dropped.
+struct FixedReach {
+  PP_HD double operator()() const { return 0.0; }
+};
+template <typename BoxA, typename Prep, typename Leaf, typename NearerA = AnyOrder, typename NearerB = AnyOrder,
+          typename Reach = FixedReach>
 PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& prep, Leaf&& leaf,
-                        NearerA nearerA = {}, NearerB nearerB = {}) {
+                        NearerA nearerA = {}, NearerB nearerB = {}, Reach reach = {}) {
   if (A.num_nodes == 0 || B.num_nodes == 0) return;
   // Each entry carries A's mapped box, so a node of A is mapped once per split, not once per
   // node of B it meets. Pairs are pushed only when their boxes overlap.
   struct Pair {
     int a, b;
     Aabb box;
+    double reach;  // reach() when the box was mapped
   };
+  constexpr bool kShrinks = !std::is_same<Reach, FixedReach>::value;
   Pair stack[kPairStack];
   int top = 0;
   {
     const Aabb root = boxA(A.nodes[0]);
     if (!aabbOverlap(root, B.nodes[0].box)) return;
-    stack[top++] = Pair{0, 0, root};
+    stack[top++] = Pair{0, 0, root, reach()};
   }
   while (top > 0) {
-    const Pair p = stack[--top];
+    Pair p = stack[--top];
     const BvhNode& na = A.nodes[p.a];
     const BvhNode& nb = B.nodes[p.b];
+    if (kShrinks && reach() < p.reach) {
+      p.box = boxA(na);
+      p.reach = reach();
+      if (!aabbOverlap(p.box, nb.box)) continue;
+    }
     const bool la = na.left < 0, lb = nb.left < 0;
     if (la) {
       // A leaf of A: its primitives are prepared once and meet every leaf of B's subtree
@@ -110,12 +124,13 @@ PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& 
         c[0] = c[1];
         c[1] = u;
       }
+      const double r = reach();
       for (int k = 0; k < 2; ++k)
-        if (aabbOverlap(cb[k], nb.box)) stack[top++] = Pair{c[k], p.b, cb[k]};
+        if (aabbOverlap(cb[k], nb.box)) stack[top++] = Pair{c[k], p.b, cb[k], r};
     } else {
       const bool swap = nearerB(B.nodes[nb.right].box, B.nodes[nb.left].box);
       for (const int c : {swap ? nb.left : nb.right, swap ? nb.right : nb.left})
-        if (aabbOverlap(p.box, B.nodes[c].box)) stack[top++] = Pair{p.a, c, p.box};
+        if (aabbOverlap(p.box, B.nodes[c].box)) stack[top++] = Pair{p.a, c, p.box, p.reach};
     }
   }
 }
@@ -139,13 +154,14 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
   auto swept = [&](const BvhNode& n) { return sweepBox(transformBox(X_GO, n.box), d, best); };
   // Moving along u: the moving part foremost along u and the fixed part hindmost first.
   auto ahead = [](V3 u) { return [u](const Aabb& x, const Aabb& y) { return dot(x.lo + x.hi, u) > dot(y.lo + y.hi, u); }; };
+  auto reach = [&] { return best; };
   // Object vertices along d against area triangles.
   auto posed = [&](int vi) { return apply(X_GO, om.vertices[vi]); };
   dualTraverse(om.vertex_bvh, am.triangle_bvh, swept, posed, [&](const V3& v, int, int t) {
     const int* tri = am.triangles + 3 * t;
     const double h = rayTriangle(v, d, am.vertices[tri[0]], am.vertices[tri[1]], am.vertices[tri[2]]);
     if (h < best) best = h;
-  }, ahead(d), ahead(-d));
+  }, ahead(d), ahead(-d), reach);
   // Object edges against area edges.
   auto posedEdge = [&](int ei) {
     const int* e = om.edges + 2 * ei;
@@ -158,7 +174,7 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
     if (!aabbOverlap(sweepBox(segmentBox(p0, p1), d, best), segmentBox(q0, q1))) return;
     const double h = edgeEdgeTranslation(p0, p1, q0, q1, d);
     if (h < best) best = h;
-  }, ahead(d), ahead(-d));
+  }, ahead(d), ahead(-d), reach);
   // Area vertices moving by -d against the object's triangles, in O.
   const V3 dir_O = -rotateInv(X_GO, d);
   auto swept_area = [&](const BvhNode& n) {
@@ -169,7 +185,7 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
     const int* tri = om.triangles + 3 * t;
     const double h = rayTriangle(w, dir_O, om.vertices[tri[0]], om.vertices[tri[1]], om.vertices[tri[2]]);
     if (h < best) best = h;
-  }, ahead(dir_O), ahead(-dir_O));
+  }, ahead(dir_O), ahead(-dir_O), reach);
   return best < tmax ? best : kInf;
 }
 

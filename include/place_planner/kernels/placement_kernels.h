@@ -114,18 +114,11 @@ PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& 
     // Both trees are at most kBvhStack / 2 deep, so this stack cannot overflow.
     // The pair to visit first is pushed last.
     if (lb || boxVolume(p.box) >= boxVolume(nb.box)) {
-      Aabb cb[2] = {boxA(A.nodes[na.right]), boxA(A.nodes[na.left])};
-      int c[2] = {na.right, na.left};
-      if (nearerA(cb[0], cb[1])) {
-        const Aabb t = cb[0];
-        cb[0] = cb[1];
-        cb[1] = t;
-        const int u = c[0];
-        c[0] = c[1];
-        c[1] = u;
-      }
+      const Aabb cb[2] = {boxA(A.nodes[na.right]), boxA(A.nodes[na.left])};
+      const int c[2] = {na.right, na.left};
+      const int last = nearerA(cb[0], cb[1]) ? 0 : 1;
       const double r = reach();
-      for (int k = 0; k < 2; ++k)
+      for (const int k : {1 - last, last})
         if (aabbOverlap(cb[k], nb.box)) stack[top++] = Pair{c[k], p.b, cb[k], r};
     } else {
       const bool swap = nearerB(B.nodes[nb.right].box, B.nodes[nb.left].box);

@@ -278,7 +278,7 @@ TEST(SphereModel, ContactHeightCullKeepsEveryContact) {
     const AreaModel am = buildAreaModel(area, {0, 0, -1}, 0.003, 0.005, 0.005);
     const AreaView av = makeAreaView(am, host);
     AreaView reference = av;
-    reference.grid.max_contact_z = reference.grid.max_z;  // cull by the collision distance only
+    reference.grid.max_contact_z = am.grid.max_z.data();  // cull by the collision distance only
     const V3 mid = 0.5 * (am.bounds.lo + am.bounds.hi);
     for (int k = 0; k < 40; ++k) {
       // Tilted up to 40 degrees about a horizontal axis, over a spiral of points on the area.

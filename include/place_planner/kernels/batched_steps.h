@@ -53,7 +53,7 @@ template <typename Up>
 AreaView makeAreaView(const AreaModel& a, Up&& up) {
   const HeightGrid& g = a.grid;
   return AreaView{makeMeshView(a, up), GridView{g.x0, g.y0, g.cell, g.nx, g.ny, g.collision_distance, g.contact_gap,
-                                                up(g.start), up(g.items), up(g.max_z), up(g.max_contact_z)}};
+                                                up(g.start), up(g.items), up(g.max_contact_z)}};
 }
 
 // ------------------------------------------------------------------ work items

@@ -251,7 +251,9 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
     // The window ends at the best angle so far: arcs past it cannot give a smaller one.
     // It also shrinks with every nearer hit, so the arcs of the nodes met after it are shorter.
     const double a0 = sigma * angleWindowStart(k);
-    AngleWindow win = angleWindow(a0, sigma * minv(angleWindowEnd(k), best));
+    // The object's window, and the area's (area vertices turn the other way relative to it).
+    auto window = [&](double dir) { return angleWindow(dir * a0, dir * sigma * minv(angleWindowEnd(k), best)); };
+    AngleWindow win = window(1);
     dualTraverse(
         om.vertex_bvh, am.triangle_bvh,
         [&](const BvhNode& n) { return arcNodeBox<false>(X_GO, n.box, s_A, d_A, win); },
@@ -270,10 +272,10 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
           const int m = vertexTriangleAngles(v, s_A, d_A, A, B, C, tp.tol, out);
           const double before = best;
           for (int j = 0; j < m; ++j) accept(out[j], sigma, v, am.triangle_normals[t], A, s_A, d_A);
-          if (best < before) win = angleWindow(a0, sigma * minv(angleWindowEnd(k), best));
+          if (best < before) win = window(1);
         });
     if (best <= angleWindowStart(k)) break;
-    AngleWindow win_area = angleWindow(-a0, -sigma * minv(angleWindowEnd(k), best));
+    AngleWindow win_area = window(-1);
     dualTraverse(
         am.vertex_bvh, om.triangle_bvh,
         [&](const BvhNode& n) { return arcNodeBox<true>(X_GO, n.box, s_O, d_O, win_area); },
@@ -292,7 +294,7 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
           const int m = vertexTriangleAngles(w, s_O, d_O, A, B, C, tp.tol, out);
           const double before = best;
           for (int j = 0; j < m; ++j) accept(out[j], -sigma, w, om.triangle_normals[t], A, s_O, d_O);
-          if (best < before) win_area = angleWindow(-a0, -sigma * minv(angleWindowEnd(k), best));
+          if (best < before) win_area = window(-1);
         });
   }
   return best < limit ? best : kInf;
@@ -310,7 +312,8 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
   const double max_angle = angleWindowEnd(kNumAngleWindows - 1);
   for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
     // The window ends at the best angle so far, and shrinks with every nearer hit.
-    AngleWindow win = angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best));
+    auto window = [&] { return angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best)); };
+    AngleWindow win = window();
     dualTraverse(
         om.edge_bvh, am.edge_bvh,
         [&](const BvhNode& n) { return arcNodeBox<false>(X_GO, n.box, s_A, d_A, win); },
@@ -333,8 +336,7 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
             const double th = directed(out[q], sigma);
             if (th > tp.min_angle && th < best && th <= max_angle) best = th;
           }
-          if (best < before)
-            win = angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best));
+          if (best < before) win = window();
         });
   }
   return best < limit ? best : kInf;

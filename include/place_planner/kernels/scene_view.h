@@ -28,7 +28,8 @@ struct GridView {
   double contact_gap;  // max separation along the area normal of a contact
   const int* start;
   const int* items;
-  const double* max_z;
+  // The highest object sphere centre that can make a contact, per cell (HeightGrid). The grid's
+  // max_z is host-only (the fall test): no kernel reads it, so it is not on the device.
   const double* max_contact_z;
 };
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "cuda_common.cuh"
-#include "place_planner/backend.h"
-#include "place_planner/cuda_backend.h"
+#include "place_planner/infra/backend.h"
+#include "place_planner/infra/cuda_backend.h"
 #include "place_planner/kernels/batched_steps.h"
 
 namespace place_planner {

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "place_planner/cuda_backend.h"
+#include "place_planner/infra/cuda_backend.h"
 
 // A failed CUDA call throws (the goal fails with INTERNAL_ERROR) and marks the device
 // unusable for backend auto until cuda::resetDevice() (cuda_backend.h).

@@ -2,7 +2,7 @@
 // nvcc): the CPU backend is used and the launchers say why they cannot run.
 #include <stdexcept>
 
-#include "place_planner/cuda_backend.h"
+#include "place_planner/infra/cuda_backend.h"
 
 namespace place_planner {
 namespace cuda {
@@ -22,7 +22,7 @@ void transformVertices(const Rigid&, const V3*, V3*, size_t) {
 }  // namespace cuda
 }  // namespace place_planner
 
-#include "place_planner/backend.h"
+#include "place_planner/infra/backend.h"
 
 namespace place_planner {
 

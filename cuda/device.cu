@@ -1,7 +1,7 @@
 #include <mutex>
 
 #include "cuda_common.cuh"
-#include "place_planner/cuda_backend.h"
+#include "place_planner/infra/cuda_backend.h"
 
 namespace place_planner {
 namespace cuda {

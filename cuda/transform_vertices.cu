@@ -1,5 +1,5 @@
 #include "cuda_common.cuh"
-#include "place_planner/cuda_backend.h"
+#include "place_planner/infra/cuda_backend.h"
 #include "place_planner/kernels/transform_vertices.h"
 
 namespace place_planner {

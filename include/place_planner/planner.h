@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "place_planner/config.h"
-#include "place_planner/mesh.h"
+#include "place_planner/model/mesh.h"
 
 namespace place_planner {
 

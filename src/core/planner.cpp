@@ -14,19 +14,19 @@
 #include <mutex>
 #include <optional>
 
-#include "place_planner/area_model_cache.h"
-#include "place_planner/area_up.h"
-#include "place_planner/backend.h"
-#include "place_planner/cuda_backend.h"
-#include "place_planner/floor_points.h"
-#include "place_planner/parallel_for.h"
-#include "place_planner/penetration.h"
-#include "place_planner/placeability.h"
-#include "place_planner/ranking.h"
-#include "place_planner/robustness.h"
-#include "place_planner/root_search.h"
-#include "place_planner/start_orientations.h"
-#include "place_planner/work_limits.h"
+#include "place_planner/model/area_model_cache.h"
+#include "place_planner/model/area_up.h"
+#include "place_planner/infra/backend.h"
+#include "place_planner/infra/cuda_backend.h"
+#include "place_planner/search/floor_points.h"
+#include "place_planner/infra/parallel_for.h"
+#include "place_planner/judgement/penetration.h"
+#include "place_planner/manipulation/placeability.h"
+#include "place_planner/judgement/ranking.h"
+#include "place_planner/judgement/robustness.h"
+#include "place_planner/search/root_search.h"
+#include "place_planner/search/start_orientations.h"
+#include "place_planner/infra/work_limits.h"
 
 namespace place_planner {
 namespace {

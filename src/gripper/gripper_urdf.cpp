@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "place_planner/gripper.h"
-#include "place_planner/mesh_io.h"
+#include "place_planner/manipulation/gripper.h"
+#include "place_planner/infra/mesh_io.h"
 
 namespace place_planner {
 namespace {

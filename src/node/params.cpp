@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "place_planner/gripper.h"
+#include "place_planner/manipulation/gripper.h"
 
 #include <XmlRpcValue.h>
 

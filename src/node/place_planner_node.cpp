@@ -12,7 +12,7 @@
 
 #include "place_planner/ros/conversions.h"
 #include "place_planner/ros/markers.h"
-#include "place_planner/work_limits.h"
+#include "place_planner/infra/work_limits.h"
 #include "place_planner/validation/physics_validator.h"
 
 namespace place_planner {

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "place_planner/ros/conversions.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/scenes.h"
 
 namespace place_planner {
 namespace {

@@ -15,9 +15,9 @@
 #include <cstring>
 #include <string>
 
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/ros/conversions.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/scenes.h"
 
 namespace {
 

@@ -13,9 +13,9 @@
 #include <memory>
 #include <string>
 
-#include "place_planner/cuda_backend.h"
-#include "place_planner/floor_points.h"
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/cuda_backend.h"
+#include "place_planner/search/floor_points.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/planner.h"
 #include "place_planner/validation/mesh_variants.h"
 

@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "place_planner/area_up.h"
-#include "place_planner/cuda_backend.h"
-#include "place_planner/gripper.h"
-#include "place_planner/mesh_io.h"
+#include "place_planner/model/area_up.h"
+#include "place_planner/infra/cuda_backend.h"
+#include "place_planner/manipulation/gripper.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/planner.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/scenes.h"
 #ifdef PLACE_PLANNER_HAVE_VALIDATION
 #include "place_planner/validation/physics_validator.h"
 #endif

@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "place_planner/planner.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/scenes.h"
 
 int main() {
   using namespace place_planner;

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/validation/mesh_variants.h"
 #include "place_planner/validation/plot.h"
 #include "place_planner/validation/suite.h"

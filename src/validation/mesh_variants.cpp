@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "place_planner/work_limits.h"
+#include "place_planner/infra/work_limits.h"
 
 namespace place_planner {
 namespace validation {

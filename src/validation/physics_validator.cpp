@@ -16,8 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "place_planner/parallel_for.h"
-#include "place_planner/stable_sort.h"
+#include "place_planner/infra/parallel_for.h"
+#include "place_planner/infra/stable_sort.h"
 
 namespace place_planner {
 namespace validation {

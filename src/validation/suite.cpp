@@ -11,9 +11,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "place_planner/area_up.h"
-#include "place_planner/mesh_io.h"
-#include "place_planner/scenes.h"
+#include "place_planner/model/area_up.h"
+#include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/scenes.h"
 #include "place_planner/validation/mesh_variants.h"
 
 namespace place_planner {

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <tuple>
 
-#include "place_planner/backend.h"
-#include "place_planner/cuda_backend.h"
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/backend.h"
+#include "place_planner/infra/cuda_backend.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/planner.h"
 #include "test_helpers.h"
 

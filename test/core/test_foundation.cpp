@@ -4,9 +4,9 @@
 #include <random>
 #include <regex>
 
-#include "place_planner/backend.h"
+#include "place_planner/infra/backend.h"
 #include "place_planner/config.h"
-#include "place_planner/cuda_backend.h"
+#include "place_planner/infra/cuda_backend.h"
 #include "place_planner/kernels/transform_vertices.h"
 #include "test_helpers.h"
 

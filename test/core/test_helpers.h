@@ -7,8 +7,8 @@
 #include <string>
 #include <sys/stat.h>
 
-#include "place_planner/mesh.h"
-#include "place_planner/scenes.h"
+#include "place_planner/model/mesh.h"
+#include "place_planner/infra/scenes.h"
 
 namespace place_planner {
 namespace test {

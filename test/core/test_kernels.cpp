@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "place_planner/backend.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/backend.h"
+#include "place_planner/infra/scenes.h"
 #include "test_helpers.h"
 
 using namespace place_planner;

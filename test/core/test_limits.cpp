@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include "place_planner/planner.h"
-#include "place_planner/scene.h"
-#include "place_planner/work_limits.h"
+#include "place_planner/model/scene.h"
+#include "place_planner/infra/work_limits.h"
 #include "test_helpers.h"
 
 using namespace place_planner;

@@ -1,7 +1,7 @@
 #include <fstream>
 #include <unistd.h>
 
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/mesh_io.h"
 #include "test_helpers.h"
 
 using namespace place_planner;

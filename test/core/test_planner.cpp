@@ -1,7 +1,7 @@
 // The planner end to end: analytic scenes with known answers, real meshes from ../shared/data.
 #include <random>
 
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/planner.h"
 #include "test_helpers.h"
 

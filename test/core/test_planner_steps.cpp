@@ -1,17 +1,17 @@
 // Each step of the planner on hand-checkable cases.
 #include <algorithm>
 
-#include "place_planner/area_up.h"
-#include "place_planner/backend.h"
-#include "place_planner/contact_points.h"
-#include "place_planner/floor_points.h"
+#include "place_planner/model/area_up.h"
+#include "place_planner/infra/backend.h"
+#include "place_planner/search/contact_points.h"
+#include "place_planner/search/floor_points.h"
 #include "place_planner/kernels/batched_steps.h"
 #include "place_planner/kernels/geometry.h"
 #include "place_planner/planner.h"
-#include "place_planner/pre_orientation.h"
-#include "place_planner/quality.h"
-#include "place_planner/stability.h"
-#include "place_planner/tilt_axis.h"
+#include "place_planner/search/pre_orientation.h"
+#include "place_planner/judgement/quality.h"
+#include "place_planner/judgement/stability.h"
+#include "place_planner/search/tilt_axis.h"
 #include "test_helpers.h"
 
 using namespace place_planner;

@@ -4,13 +4,13 @@
 #include <map>
 #include <memory>
 
-#include "place_planner/backend.h"
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/backend.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/planner.h"
-#include "place_planner/resting_faces.h"
-#include "place_planner/robustness.h"
-#include "place_planner/stability.h"
-#include "place_planner/tree_stepper.h"
+#include "place_planner/search/resting_faces.h"
+#include "place_planner/judgement/robustness.h"
+#include "place_planner/judgement/stability.h"
+#include "place_planner/search/tree_stepper.h"
 #include "test_helpers.h"
 
 using namespace place_planner;

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/mesh_io.h"
 #include "test_helpers.h"
 
 using namespace place_planner;

@@ -9,9 +9,9 @@
 #include <sstream>
 #include <vector>
 
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/planner.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/scenes.h"
 
 namespace place_planner {
 namespace fuzz {

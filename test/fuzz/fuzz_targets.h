@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "place_planner/mesh.h"
+#include "place_planner/model/mesh.h"
 
 namespace place_planner {
 namespace fuzz {

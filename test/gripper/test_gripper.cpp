@@ -7,10 +7,10 @@
 #include <Eigen/Geometry>
 #include <memory>
 
-#include "place_planner/gripper.h"
-#include "place_planner/mesh_io.h"
+#include "place_planner/manipulation/gripper.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/planner.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/scenes.h"
 
 using namespace place_planner;
 

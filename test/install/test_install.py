@@ -59,7 +59,7 @@ class InstallTree(unittest.TestCase):
         for program in ["place_planner_node", "place_planner_cli", "make_demo_bag", "demo_client"]:
             path = os.path.join(INSTALL, "lib", "place_planner", program)
             self.assertTrue(os.access(path, os.X_OK), program + " not installed")
-        for header in ["planner.h", "config.h", "mesh_io.h", "kernels/placement_kernels.h",
+        for header in ["planner.h", "config.h", "infra/mesh_io.h", "search/tree_stepper.h", "judgement/stability.h", "kernels/placement_kernels.h",
                        "PlacePlanAction.h", "PlacementCandidate.h"]:
             self.assertTrue(os.path.isfile(os.path.join(INSTALL, "include", "place_planner", header)), header)
         self.assertTrue(os.path.isfile(os.path.join(INSTALL, "lib", "libplace_planner_core.a")))
@@ -135,7 +135,7 @@ class InstallTree(unittest.TestCase):
                         "target_include_directories(pp_user PRIVATE ${catkin_INCLUDE_DIRS})\n"
                         "target_link_libraries(pp_user ${catkin_LIBRARIES})\n")
             with open(os.path.join(src, "main.cpp"), "w") as f:
-                f.write('#include <cstdio>\n#include "place_planner/planner.h"\n#include "place_planner/scenes.h"\n'
+                f.write('#include <cstdio>\n#include "place_planner/planner.h"\n#include "place_planner/infra/scenes.h"\n'
                         "int main() {\n  place_planner::PlannerConfig c;\n  c.robust_check = false;\n"
                         "  c.backend = place_planner::BackendKind::kCpu;\n"
                         "  c.orientation = place_planner::OrientationMode::kPrincipalAxis;\n"

@@ -19,9 +19,9 @@
 #include <thread>
 #include <vector>
 
-#include "place_planner/cuda_backend.h"
-#include "place_planner/mesh_io.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/cuda_backend.h"
+#include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/scenes.h"
 
 namespace place_planner {
 namespace {

@@ -24,9 +24,9 @@
 #include "place_planner/PlacePlanAction.h"
 #include "place_planner/ros/conversions.h"
 #include "place_planner/ros/markers.h"
-#include "place_planner/cuda_backend.h"
+#include "place_planner/infra/cuda_backend.h"
 #include "place_planner/ros/params.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/scenes.h"
 
 namespace place_planner {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "place_planner/ros/conversions.h"
 #include "place_planner/ros/prepare_goal.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/scenes.h"
 
 namespace place_planner {
 namespace {

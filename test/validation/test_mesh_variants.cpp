@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "place_planner/mesh_io.h"
-#include "place_planner/scenes.h"
+#include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/scenes.h"
 #include "place_planner/validation/mesh_variants.h"
 #include "validation_test_helpers.h"
 

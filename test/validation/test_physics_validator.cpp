@@ -4,10 +4,10 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
-#include "place_planner/mesh_io.h"
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/planner.h"
-#include "place_planner/resting_faces.h"
-#include "place_planner/scenes.h"
+#include "place_planner/search/resting_faces.h"
+#include "place_planner/infra/scenes.h"
 #include "place_planner/validation/physics_validator.h"
 #include "validation_test_helpers.h"
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "place_planner/backend.h"
+#include "place_planner/infra/backend.h"
 
 namespace place_planner {
 

@@ -3,7 +3,7 @@
 // planning frame rotated so that gravity is -z); angles are counter-clockwise about the unit
 // axis direction d_A (right-hand rule), in [0, 2*pi).
 #pragma once
-#include "place_planner/hd_math.h"
+#include "place_planner/model/hd_math.h"
 
 namespace place_planner {
 

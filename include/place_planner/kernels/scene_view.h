@@ -2,7 +2,7 @@
 // CUDA kernels. Built from scene.h models by view(); the CUDA backend uploads the arrays and
 // fills the same structs with device pointers.
 #pragma once
-#include "place_planner/bvh.h"
+#include "place_planner/model/bvh.h"
 
 namespace place_planner {
 

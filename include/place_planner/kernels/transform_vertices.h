@@ -3,7 +3,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "place_planner/hd_math.h"
+#include "place_planner/model/hd_math.h"
 
 namespace place_planner {
 

@@ -15,7 +15,7 @@
 
 #include "place_planner/PlacePlanFeedback.h"
 #include "place_planner/PlacementCandidate.h"
-#include "place_planner/mesh.h"
+#include "place_planner/model/mesh.h"
 #include "place_planner/planner.h"
 
 namespace place_planner {

@@ -7,8 +7,8 @@
 #include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "place_planner/gripper.h"
-#include "place_planner/mesh.h"
+#include "place_planner/manipulation/gripper.h"
+#include "place_planner/model/mesh.h"
 #include "place_planner/planner.h"
 
 namespace place_planner {

@@ -15,7 +15,7 @@
 #include <shape_msgs/Mesh.h>
 
 #include "place_planner/PlacePlanAction.h"
-#include "place_planner/mesh.h"
+#include "place_planner/model/mesh.h"
 #include "place_planner/config.h"
 #include "place_planner/ros/params.h"
 

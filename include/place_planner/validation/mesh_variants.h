@@ -3,7 +3,7 @@
 #pragma once
 #include <cstdint>
 
-#include "place_planner/mesh.h"
+#include "place_planner/model/mesh.h"
 
 namespace place_planner {
 namespace validation {

@@ -22,7 +22,7 @@
 #include <functional>
 #include <memory>
 
-#include "place_planner/mesh.h"
+#include "place_planner/model/mesh.h"
 #include "place_planner/planner.h"
 
 namespace place_planner {

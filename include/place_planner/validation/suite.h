@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "place_planner/config.h"
-#include "place_planner/mesh.h"
+#include "place_planner/model/mesh.h"
 #include "place_planner/planner.h"
 #include "place_planner/validation/physics_validator.h"
 

@@ -1,0 +1,44 @@
+// Built-in analytic meshes and demo scenes, so the demo, the bag tool and the tests run without
+// any third-party mesh file. All in metres, z up; areas rest on z = 0, centred in x/y.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "place_planner/model/mesh.h"
+
+namespace place_planner {
+namespace scenes {
+
+// Closed axis-aligned box [−sx/2, sx/2] x [−sy/2, sy/2] x [−sz/2, sz/2] + center, 6 quads,
+// outward CCW.
+Mesh box(double sx, double sy, double sz, const Eigen::Vector3d& center = Eigen::Vector3d::Zero());
+// Closed cylinder along z, radius r, height h, `segments` sides, centred at the origin.
+Mesh cylinder(double r, double h, int segments = 32);
+// The same with an elliptic cross-section: semi-axes a along x, b along y.
+Mesh ellipticCylinder(double a, double b, double h, int segments = 32);
+// A single square plane of side `size` at z = 0 (normal +z), optionally tilted about x.
+Mesh plane(double size_x, double size_y, double tilt_deg = 0.0);
+// Two planes forming a V trough along x, each tilted by +-angle_deg, meeting at z = 0.
+Mesh vTrough(double size, double angle_deg);
+// Appends b to a (vertices re-indexed); the result is rebuilt and validated.
+Mesh merge(const std::vector<Mesh>& parts, const std::string& name = "merged");
+
+// Demo placement areas.
+Mesh table();         // 1.0 x 0.8 m table top, 3 cm thick
+Mesh dishRack();      // tray 0.45 x 0.45 m with a grid of vertical pegs
+Mesh openBox();       // box with walls, open on top (0.3 x 0.25 x 0.12 m)
+Mesh binderStack();   // three binders stacked with offsets on a table top
+// Demo objects (mesh frame at their base centre, like a scan).
+Mesh mug();           // cylinder body with a handle, 0.08 m diameter
+Mesh plate();         // flat disc 0.24 m, 2 cm thick rim
+Mesh pen();           // thin cylinder 0.14 m long
+
+// Names accepted by byName(): table, dish_rack, open_box, binder_stack, mug, plate, pen, cube.
+Mesh byName(const std::string& name);
+std::vector<std::string> areaNames();
+std::vector<std::string> objectNames();
+
+}  // namespace scenes
+}  // namespace place_planner

@@ -1,0 +1,60 @@
+// The search over roots (Sections IV-A, IV-B): floor point x start orientation, in an anytime
+// order, each root a pose above its floor point from which a tree starts. Frame G.
+#pragma once
+#include <Eigen/Core>
+#include <vector>
+
+#include "place_planner/model/mesh.h"
+#include "place_planner/model/scene.h"
+#include "place_planner/search/start_orientations.h"
+
+namespace place_planner {
+
+// Anytime order of floor points: amid a wide flat neighbourhood first (more neighbours at the
+// same height), then central ones; such points rarely let the object hang over an edge, so
+// good poses come early. The set is the paper's; only the order changes.
+std::vector<V3> orderFloorPoints(const std::vector<V3>& points, double spacing);
+
+class RootSearch {
+ public:
+  // Roots k = f * |orientations| + o: for each floor point (in order), every orientation
+  // (likeliest first), so the first trees cover the likeliest orientations.
+  RootSearch(const std::vector<V3>& floor_points_G, const std::vector<StartOrientation>& orientations,
+             const MeshProperties& object, const AreaModel& area, const V3& d_vis_G);
+  int size() const { return static_cast<int>(floor_points_.size() * orientations_.size()); }
+  int floorPoint(int root) const { return root / static_cast<int>(orientations_.size()); }
+  StartKind kind(int root) const { return orientations_[root % orientations_.size()].kind; }
+  // The root's pose: centre of mass above the floor point along -d_vis, clear of everything
+  // (V-A, first step), and the translation to do along d_vis.
+  Rigid pose(int root) const;
+  double tmax(int root) const;
+  double clearance(int root) const;
+  const V3& d_vis() const { return d_vis_; }
+
+ private:
+  std::vector<V3> floor_points_;
+  std::vector<StartOrientation> orientations_;
+  Eigen::Vector3d com_O_;
+  double radius_;
+  V3 d_vis_;
+  double hmax_ = 0, hmin_ = 0;  // the area's extent along -d_vis
+};
+
+}  // namespace place_planner
+
+#include <functional>
+
+#include "place_planner/search/tree_stepper.h"
+
+namespace place_planner {
+
+// Streams the roots into the stepper (anytime): whenever trees end, new roots take their
+// places, so a pose that settles in a few steps is not held up by a long tree. The batch starts
+// at first_batch and doubles every other step up to `batch`. Each tree depends on its root
+// only: the leaves are the same whatever the batch. `after_step(leaves)` is called after every
+// batched step with the open roots counted; false stops the search.
+void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O, int batch,
+                 std::vector<TreeLeaf>& leaves,
+                 const std::function<bool(int roots_started, int roots_open)>& after_step);
+
+}  // namespace place_planner

@@ -1,0 +1,108 @@
+// The tree of rotations of every pending pose, advanced one batched step at a time (Sections
+// V-A to VI, batched as in VII-C). Frame G (gravity -z). Each tree starts at a root pose with
+// translations pending; its leaves are resting poses (stable or not).
+#pragma once
+#include <Eigen/Core>
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "place_planner/infra/backend.h"
+#include "place_planner/planner.h"
+#include "place_planner/model/scene.h"
+#include "place_planner/judgement/stability.h"
+
+namespace place_planner {
+
+struct TreeNode {
+  Rigid X_GO;
+  int root = 0;       // caller's id of the tree (root index, or robustness trial)
+  int depth = 0;      // rotations of the tree (Section V-C), not counting small ones
+  int turns = 0;      // all rotations, small ones included
+  int opt = 0;        // local optimisation steps (Section VI)
+  V3 com_O{0, 0, 0};  // centre of mass used for stability, frame O (perturbed in trials)
+  std::vector<Rigid> path;      // X_GO after each translation or rotation
+  std::vector<V3> pending;      // translations still to do: directions (G) ...
+  std::vector<double> pending_tmax;  // ... and their search limits (m)
+  // Rotation request (Section V-C): axis through s_A along d_A (G).
+  Eigen::Vector3d s_A = Eigen::Vector3d::Zero(), d_A = Eigen::Vector3d::UnitX();
+  bool both_directions = true;
+  bool local_rotation = false;
+  std::vector<ContactPoint> contacts;  // frame G
+  // Its last stability test, kept while it turns: a leaf when no turn is found.
+  double quality = -1, tipping_angle = 0;
+  bool supported = false;
+  // Roll settle (rollStep, beyond the paper): 1 when this pose is the bottom of a roll about a
+  // line of contacts, with `roll_margin` (rad) to the nearest crest of the roll either way.
+  int roll = 0;
+  double roll_margin = 0;
+  int rocks = 0;          // rock settle steps taken (rockStep)
+  bool overhang = false;  // its last pose was past its support over a drop (see fall_tip)
+};
+
+struct TreeLeaf {
+  Rigid X_GO;
+  int root = 0;
+  bool stable = false;
+  bool at_rest = true;   // false: cut by max_rotations while still tilting
+  // Statically supported: the centre of mass inside the support with the tipping margin and
+  // friction holding, without the quality bound that `stable` adds (robustness trials).
+  bool supported = false;
+  double quality = -1;
+  double tipping_angle = 0;  // rad (planar supports)
+  std::vector<ContactPoint> contacts;  // frame G
+  std::vector<Rigid> path;
+  bool rolled = false;  // it came to rest at the bottom of a roll (rollStep)
+  bool fell = false;    // the tree was cut while falling over a ledge (TreeContext::fall_tip)
+};
+
+struct TreeContext {
+  const ObjectModel& om;
+  const AreaModel& am;
+  Backend& backend;
+  StabilityParams stability;
+  double cd = 0;             // collision distance, m (V-B)
+  int max_rotations = 5;
+  int max_opt = 8;
+  int threads = 0;
+  StepTimes* times = nullptr;  // accumulated per step, may be null
+  long* tree_nodes = nullptr;  // poses evaluated, may be null
+  // A tree ends, not stable, when two poses in a row have their centre of mass more than this
+  // (rad) past their support, over a drop (tree_stepper.cpp); 0: never.
+  double fall_tip = 35.0 * M_PI / 180.0;
+  // A stable pose is rocked about the horizontal axes through its centre of mass and moves
+  // where a rock lowers it (rockStep); false: the static test decides alone.
+  bool rock_settle = false;
+};
+
+class TreeStepper {
+ public:
+  explicit TreeStepper(const TreeContext& ctx);
+  // A tree: its first pose X_GO (also the first entry of its path) and the translation to do.
+  void addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax);
+  size_t active() const {
+    return translate_.size() + contact_.size() + rotating_.size() + rolling_.size() + rocking_.size();
+  }
+  bool empty() const { return active() == 0; }
+  // One batched step of every pending pose; trees that end append their leaves.
+  void step(std::vector<TreeLeaf>& leaves);
+  // Roots with poses still pending, sorted, unique.
+  std::vector<int> openRoots() const;
+  // Drops every pending pose for which drop(node) is true (a tree whose outcome is known).
+  void prune(const std::function<bool(const TreeNode&)>& drop);
+
+ private:
+  void firstContactStep();                        // V-A
+  void contactStep(std::vector<TreeLeaf>& leaves);  // V-B, VI, V-C.1
+  void tiltStep(std::vector<TreeLeaf>& leaves);   // V-C.2
+  void rollStep();                                // beyond the paper: a roller's rest
+  void rockStep(std::vector<TreeLeaf>& leaves);   // beyond the paper: at rest, or rocking
+  TreeContext ctx_;
+  double diag_;  // of the area's bounds, limits slides
+  std::vector<TreeNode> translate_, contact_, rotating_, rolling_, rocking_;
+};
+
+// Rotation by `angle` about the axis (s, d) applied after X.
+Rigid rotatedAbout(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector3d& d, double angle);
+
+}  // namespace place_planner

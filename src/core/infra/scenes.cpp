@@ -1,0 +1,165 @@
+#include "place_planner/infra/scenes.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace place_planner {
+namespace scenes {
+namespace {
+
+struct Builder {
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::vector<int>> f;
+  void add(const Mesh& m, const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity(),
+           const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) {
+    const int off = static_cast<int>(v.size());
+    for (const auto& p : m.vertices) v.push_back(R * p + t);
+    for (auto poly : m.patches) {
+      for (int& i : poly) i += off;
+      f.push_back(poly);
+    }
+  }
+  Mesh build(const std::string& name) const { return buildMesh(v, f, name); }
+};
+
+Eigen::Matrix3d rotZ(double deg) {
+  return Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+}  // namespace
+
+Mesh box(double sx, double sy, double sz, const Eigen::Vector3d& c) {
+  const double x = sx / 2, y = sy / 2, z = sz / 2;
+  std::vector<Eigen::Vector3d> v = {{-x, -y, -z}, {x, -y, -z}, {x, y, -z}, {-x, y, -z},
+                                    {-x, -y, z},  {x, -y, z},  {x, y, z},  {-x, y, z}};
+  for (auto& p : v) p += c;
+  // Counter-clockwise seen from outside.
+  std::vector<std::vector<int>> f = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                     {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  return buildMesh(v, f, "box");
+}
+
+namespace {
+// Closed prism along z over an ellipse (semi-axes a along x, b along y), centred at the origin.
+Mesh ellipticPrism(double a, double b, double h, int segments, const char* name) {
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::vector<int>> f;
+  for (int i = 0; i < segments; ++i) {
+    const double phi = 2 * M_PI * i / segments;
+    v.emplace_back(a * std::cos(phi), b * std::sin(phi), -h / 2);
+  }
+  for (int i = 0; i < segments; ++i) v.emplace_back(v[i].x(), v[i].y(), h / 2);
+  std::vector<int> bottom, top;
+  for (int i = 0; i < segments; ++i) {
+    bottom.push_back(segments - 1 - i);
+    top.push_back(segments + i);
+    const int j = (i + 1) % segments;
+    f.push_back({i, j, segments + j, segments + i});
+  }
+  f.push_back(bottom);
+  f.push_back(top);
+  return buildMesh(v, f, name);
+}
+}  // namespace
+
+Mesh cylinder(double r, double h, int segments) { return ellipticPrism(r, r, h, segments, "cylinder"); }
+
+Mesh ellipticCylinder(double a, double b, double h, int segments) {
+  return ellipticPrism(a, b, h, segments, "elliptic cylinder");
+}
+
+Mesh plane(double sx, double sy, double tilt_deg) {
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(tilt_deg * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  std::vector<Eigen::Vector3d> v = {R * Eigen::Vector3d(-sx / 2, -sy / 2, 0),
+                                    R * Eigen::Vector3d(sx / 2, -sy / 2, 0),
+                                    R * Eigen::Vector3d(sx / 2, sy / 2, 0),
+                                    R * Eigen::Vector3d(-sx / 2, sy / 2, 0)};
+  return buildMesh(v, {{0, 1, 2, 3}}, "plane");
+}
+
+Mesh vTrough(double size, double angle_deg) {
+  const double a = angle_deg * M_PI / 180.0;
+  const double dy = size / 2 * std::cos(a), dz = size / 2 * std::sin(a);
+  std::vector<Eigen::Vector3d> v = {{-size / 2, -dy, dz}, {size / 2, -dy, dz}, {size / 2, 0, 0},
+                                    {-size / 2, 0, 0},    {size / 2, dy, dz},  {-size / 2, dy, dz}};
+  return buildMesh(v, {{0, 3, 2, 1}, {3, 5, 4, 2}}, "v_trough");
+}
+
+Mesh merge(const std::vector<Mesh>& parts, const std::string& name) {
+  Builder b;
+  for (const auto& m : parts) b.add(m);
+  return b.build(name);
+}
+
+Mesh table() { return box(1.0, 0.8, 0.03, {0, 0, -0.015}); }
+
+Mesh dishRack() {
+  Builder b;
+  b.add(box(0.45, 0.45, 0.01, {0, 0, 0.005}));
+  // Rows of pegs along x, 6 cm apart in y: a plate stands between two rows.
+  for (int iy = -3; iy <= 3; ++iy)
+    for (int ix = -4; ix <= 4; ++ix)
+      b.add(box(0.01, 0.01, 0.08, {0.05 * ix, 0.06 * iy, 0.05}));
+  return b.build("dish_rack");
+}
+
+Mesh openBox() {
+  Builder b;
+  const double sx = 0.3, sy = 0.25, h = 0.12, t = 0.01;
+  b.add(box(sx, sy, t, {0, 0, t / 2}));
+  b.add(box(t, sy, h, {-sx / 2 + t / 2, 0, h / 2}));
+  b.add(box(t, sy, h, {sx / 2 - t / 2, 0, h / 2}));
+  b.add(box(sx - 2 * t, t, h, {0, -sy / 2 + t / 2, h / 2}));
+  b.add(box(sx - 2 * t, t, h, {0, sy / 2 - t / 2, h / 2}));
+  return b.build("open_box");
+}
+
+Mesh binderStack() {
+  Builder b;
+  b.add(box(0.6, 0.5, 0.02, {0, 0, 0.01}));
+  const double th = 0.05;
+  b.add(box(0.31, 0.26, th), rotZ(0), {-0.05, 0.0, 0.02 + th / 2});
+  b.add(box(0.31, 0.26, th), rotZ(12), {0.0, 0.03, 0.02 + 1.5 * th});
+  b.add(box(0.31, 0.26, th), rotZ(-8), {0.04, -0.02, 0.02 + 2.5 * th});
+  return b.build("binder_stack");
+}
+
+Mesh mug() {
+  Builder b;
+  const Mesh body = cylinder(0.04, 0.1, 24);
+  b.add(body, Eigen::Matrix3d::Identity(), {0, 0, 0.05});
+  b.add(box(0.02, 0.015, 0.06), Eigen::Matrix3d::Identity(), {0.05, 0, 0.05});
+  return b.build("mug");
+}
+
+Mesh plate() {
+  Builder b;
+  b.add(cylinder(0.12, 0.02, 32), Eigen::Matrix3d::Identity(), {0, 0, 0.01});
+  return b.build("plate");
+}
+
+Mesh pen() {
+  Builder b;
+  b.add(cylinder(0.006, 0.14, 12), Eigen::Matrix3d::Identity(), {0, 0, 0.07});
+  return b.build("pen");
+}
+
+Mesh byName(const std::string& n) {
+  if (n == "table") return table();
+  if (n == "dish_rack") return dishRack();
+  if (n == "open_box") return openBox();
+  if (n == "binder_stack") return binderStack();
+  if (n == "mug") return mug();
+  if (n == "plate") return plate();
+  if (n == "pen") return pen();
+  if (n == "cube") return box(0.1, 0.1, 0.1, {0, 0, 0.05});
+  throw std::invalid_argument("unknown built-in scene '" + n +
+                              "' (table, dish_rack, open_box, binder_stack, mug, plate, pen, cube)");
+}
+
+std::vector<std::string> areaNames() { return {"table", "dish_rack", "open_box", "binder_stack"}; }
+std::vector<std::string> objectNames() { return {"mug", "plate", "pen", "cube"}; }
+
+}  // namespace scenes
+}  // namespace place_planner

@@ -1,0 +1,212 @@
+// Candidate ranking (ranking.h).
+#include "place_planner/judgement/ranking.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "place_planner/search/contact_points.h"
+#include "place_planner/manipulation/placeability.h"
+#include "place_planner/infra/stable_sort.h"
+
+namespace place_planner {
+namespace {
+
+struct Item {
+  size_t leaf;
+  bool stable;
+  double quality, reorientation;
+  Robustness robustness;
+  bool checked = false;
+  long preference = 0;  // config.rank_order's key, lower first
+  Placement placement;
+  double score() const {
+    const double share = checked ? robustness.share() : 1.0;
+    return quality - 0.05 * reorientation / M_PI - 0.05 * (1.0 - share);
+  }
+};
+
+// Scores equal to 1e-3 are ties (the same placement seen through another frame differs only
+// by rounding); ties go to the pose nearer the frame's vertical axis, then by position on a 1 mm
+// lattice: an order that depends on the geometry, not on the order roots were tried in.
+long quantised(double v, double step) { return std::lround(v / step); }
+
+void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
+  stableSortAligned(items, [&](const Item& a, const Item& b) {
+    if (a.stable != b.stable) return a.stable;
+    if (a.preference != b.preference) return a.preference < b.preference;
+    const long sa = quantised(a.score(), 1e-3), sb = quantised(b.score(), 1e-3);
+    if (sa != sb) return sa > sb;
+    const V3 pa = leaves[a.leaf].X_GO.t, pb = leaves[b.leaf].X_GO.t;
+    const long ra = quantised(pa.x * pa.x + pa.y * pa.y, 1e-6), rb = quantised(pb.x * pb.x + pb.y * pb.y, 1e-6);
+    if (ra != rb) return ra < rb;
+    const long xa = quantised(pa.x, 1e-3), xb = quantised(pb.x, 1e-3);
+    if (xa != xb) return xa < xb;
+    const long ya = quantised(pa.y, 1e-3), yb = quantised(pb.y, 1e-3);
+    if (ya != yb) return ya < yb;
+    return leaves[a.leaf].root < leaves[b.leaf].root;
+  });
+}
+
+}  // namespace
+
+std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfig& config,
+                                      const RobustnessCheck& check, PlanStats* stats,
+                                      const PlacementCheck& place) {
+  const auto& leaves = in.leaves;
+  std::vector<Item> items;
+  const Eigen::Vector3d near_G = in.R_GW * config.prefer_near;
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    const TreeLeaf& l = leaves[i];
+    if (l.quality < config.min_quality) continue;
+    const Eigen::Isometry3d X = toIsometry(l.X_GO);
+    if (!gripperTiltOk(X.linear(), config)) {
+      if (stats) ++stats->gripper_tilt_rejected;
+      continue;
+    }
+    Item it{i, l.stable, l.quality, rotationAngle(in.R_held_G, X.linear()), {}, false, 0, {}};
+    if (config.rank_order == RankOrder::kLowest) it.preference = quantised((X * in.com_O).z(), 0.005);
+    if (config.rank_order == RankOrder::kNearest) it.preference = quantised((X * in.com_O - near_G).norm(), 0.005);
+    items.push_back(it);
+  }
+  sortItems(items, leaves);
+  // Merge: a pose near a better one is the same candidate (G and W differ by a rotation only).
+  const double merge_angle = config.merge_angle_deg * M_PI / 180.0;
+  std::vector<Item> distinct;
+  std::vector<Eigen::Isometry3d> kept;  // poses of `distinct`, converted once
+  // A leaf the search already found robust stands for its group: it needs no check when the
+  // budget has run out by the ranking.
+  auto robustAlready = [&](size_t leaf) {
+    return std::find(in.robust_leaves.begin(), in.robust_leaves.end(), leaf) != in.robust_leaves.end();
+  };
+  auto close = [&](const Eigen::Isometry3d& X, const Eigen::Isometry3d& Y) {
+    return (X.translation() - Y.translation()).norm() < config.merge_distance &&
+           rotationAngle(X.linear(), Y.linear()) < merge_angle;
+  };
+  for (const Item& it : items) {
+    const Eigen::Isometry3d X = toIsometry(leaves[it.leaf].X_GO);
+    std::vector<size_t> near;
+    for (size_t k = 0; k < kept.size(); ++k)
+      if (close(X, kept[k])) near.push_back(k);
+    if (!near.empty()) {
+      // It takes the group's place only where it is near that group alone (merged stays merged).
+      const size_t dup = near.front();
+      if (near.size() == 1 && it.stable && robustAlready(it.leaf) && !robustAlready(distinct[dup].leaf)) {
+        distinct[dup] = it;
+        kept[dup] = X;
+      }
+      continue;
+    }
+    distinct.push_back(it);
+    kept.push_back(X);
+  }
+  // Placeability first (cheap next to robustness): a blocked candidate is not stable.
+  int place_checks = 0;
+  auto placeable = [&](Item& it) {
+    if (!place || it.placement.checked) return it.placement.blocked.empty();
+    // Bounded work: when the gripper blocks pose after pose, the search for more stops.
+    if (++place_checks > 10L * config.max_candidates) return false;
+    it.placement = place(it.leaf);
+    if (it.placement.blocked.empty()) return true;
+    if (stats) ++stats->gripper_rejected;
+    it.stable = false;
+    return false;
+  };
+  // Robustness, best stable first, until max_candidates robust ones are found.
+  if (config.robust_check && check) {
+    // A leaf's robustness decides its stable flag; true when it holds.
+    auto record = [&](Item& it, const Robustness& r) {
+      it.robustness = r;
+      it.checked = r.trials > 0;
+      it.stable = it.checked && r.share() >= config.robust_min_share - 1e-9;
+      return it.stable;
+    };
+    int robust = 0, checked = 0;
+    size_t next = 0;
+    // Bounded work: at most four times max_candidates leaves are checked.
+    while (robust < config.max_candidates && checked < 4L * config.max_candidates) {
+      std::vector<size_t> batch, where;
+      for (; next < distinct.size() && batch.size() < static_cast<size_t>(config.max_candidates - robust); ++next)
+        if (distinct[next].stable && placeable(distinct[next])) {
+          batch.push_back(distinct[next].leaf);
+          where.push_back(next);
+        }
+      if (batch.empty()) break;
+      const std::vector<Robustness> rs = check(batch);
+      checked += static_cast<int>(batch.size());
+      for (size_t j = 0; j < where.size(); ++j) {
+        Item& it = distinct[where[j]];
+        const bool ok = record(it, rs[j]);
+        if (stats) {
+          stats->robustness_checked += it.checked;
+          stats->robustness_rejected += !ok;
+        }
+        robust += ok;
+      }
+    }
+    // Cut by a cancel or the budget, the checks above may end before the leaves the search found
+    // robust: those stay robust (their results are the search's, not checked again), so what was
+    // found is returned.
+    std::vector<size_t> found, where;
+    const bool cut = in.cut && in.cut();
+    for (size_t k = 0; k < distinct.size() && cut; ++k)
+      if (distinct[k].stable && !distinct[k].checked && robustAlready(distinct[k].leaf) && placeable(distinct[k])) {
+        found.push_back(distinct[k].leaf);
+        where.push_back(k);
+      }
+    if (!found.empty()) {
+      const std::vector<Robustness> rs = check(found);
+      for (size_t j = 0; j < where.size(); ++j) record(distinct[where[j]], rs[j]);
+    }
+    // Stable leaves never checked (out of time, or beyond the candidates needed) are not
+    // claimed stable.
+    for (Item& it : distinct)
+      if (it.stable && !it.checked) it.stable = false;
+    sortItems(distinct, leaves);
+  }
+  const Eigen::Matrix3d R_WG = in.R_GW.transpose();
+  std::vector<Candidate> out;
+  if (place) {
+    // Without the robustness loop, or past it: the rest are checked in rank order.
+    int kept = 0;
+    for (Item& it : distinct) {
+      if (kept >= config.max_candidates) break;
+      kept += placeable(it) || config.keep_colliding;
+    }
+    sortItems(distinct, leaves);
+  }
+  for (const Item& it : distinct) {
+    if (static_cast<int>(out.size()) >= config.max_candidates) break;
+    if (place && !it.placement.checked) continue;
+    if (!it.placement.blocked.empty() && !config.keep_colliding) continue;
+    const TreeLeaf& l = leaves[it.leaf];
+    Candidate c;
+    const Eigen::Isometry3d X_GO = toIsometry(l.X_GO);
+    c.X_WO.linear() = R_WG * X_GO.linear();
+    c.X_WO.translation() = R_WG * X_GO.translation();
+    c.quality = l.quality;
+    c.stable = it.stable;
+    c.robustness = it.robustness;
+    c.start = in.root_kind[l.root];
+    c.reorientation = it.reorientation;
+    // The result summarises the contacts in cells of a third of the object's radius.
+    for (const auto& p : reduceContacts(l.contacts, in.object_radius / 3.0))
+      c.contacts.push_back({R_WG * p.p_W, R_WG * p.n_W});
+    c.floor_point_W = in.root_floor_point_W[l.root];
+    c.placement = it.placement;
+    if (config.has_grasp) {
+      c.has_gripper_pose = true;
+      c.X_WF = c.X_WO * config.grasp;
+    }
+    for (const Rigid& X : l.path) {
+      const Eigen::Isometry3d T = toIsometry(X);
+      Eigen::Isometry3d W = Eigen::Isometry3d::Identity();
+      W.linear() = R_WG * T.linear();
+      W.translation() = R_WG * T.translation();
+      c.intermediate_poses.push_back(W);
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace place_planner

@@ -1,0 +1,224 @@
+#include "place_planner/model/scene.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <future>
+#include <atomic>
+#include <cstdint>
+
+#include "place_planner/model/area_up.h"
+
+namespace place_planner {
+
+Rigid toRigid(const Eigen::Isometry3d& T) {
+  Rigid r;
+  for (int i = 0; i < 9; ++i) r.R[i] = T.linear()(i / 3, i % 3);
+  r.t = toV3(T.translation());
+  return r;
+}
+
+Eigen::Isometry3d toIsometry(const Rigid& r) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 9; ++i) T.linear()(i / 3, i % 3) = r.R[i];
+  T.translation() = toEigen(r.t);
+  return T;
+}
+
+Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W) {
+  // Minimal rotation taking -d_g to +z; identity for the default d_g = -z.
+  const Eigen::Vector3d up = -gravity_W.normalized();
+  return Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg, const StopSignal* stop) {
+  // Each undirected edge with the triangles on it, and whether the first traverses it a -> b:
+  // sorted (edge key, triangle) pairs grouped by key (a map is ten times slower on big scans).
+  struct EdgeUse {
+    int tris[2] = {-1, -1};
+    int count = 0;
+    int forward = 0;  // triangles traversing it from the lower index to the higher
+  };
+  auto edgeKey = [](int a, int b) { return (static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b); };
+  std::vector<std::pair<uint64_t, int>> sides;  // key, triangle * 2 + forward
+  sides.reserve(3 * mesh.triangles.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    pollStop(stop, t, 1u << 14);
+    for (int k = 0; k < 3; ++k) {
+      int a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      const bool fwd = a < b;
+      if (a > b) std::swap(a, b);
+      sides.emplace_back(edgeKey(a, b), static_cast<int>(2 * t + fwd));
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  if (stop) stop->throwIfRequested();
+  std::vector<uint64_t> keys;
+  std::vector<EdgeUse> uses;
+  for (const auto& sd : sides) {
+    if (keys.empty() || keys.back() != sd.first) keys.push_back(sd.first), uses.emplace_back();
+    EdgeUse& u = uses.back();
+    if (u.count < 2) u.tris[u.count] = sd.second / 2;
+    ++u.count;
+    u.forward += sd.second % 2;
+  }
+  auto useOf = [&](int a, int b) -> const EdgeUse* {
+    const auto it = std::lower_bound(keys.begin(), keys.end(), edgeKey(a, b));
+    return it != keys.end() && *it == edgeKey(a, b) ? &uses[it - keys.begin()] : nullptr;
+  };
+  // Which side is solid, per connected piece (a scene may merge parts wound either way): on a
+  // consistently wound, (nearly) closed piece the winding's normals point out where its signed
+  // volume is positive and in where it is negative. Open sheets and scans (more than 2 % border
+  // edges) have no inside: every side may be touched (outward 0).
+  std::vector<int> piece(mesh.triangles.size());
+  for (size_t t = 0; t < piece.size(); ++t) piece[t] = static_cast<int>(t);
+  auto find = [&](int t) {
+    while (piece[t] != t) t = piece[t] = piece[piece[t]];
+    return t;
+  };
+  for (const EdgeUse& e : uses)
+    if (e.count == 2) piece[find(e.tris[0])] = find(e.tris[1]);
+  struct Piece {
+    int edges = 0, border = 0;
+    bool consistent = true;
+    double volume = 0;
+  };
+  std::vector<Piece> pieces(mesh.triangles.size());  // at each piece's root triangle
+  for (const EdgeUse& e : uses) {
+    Piece& p = pieces[find(e.tris[0])];
+    ++p.edges;
+    p.border += e.count == 1;
+    if (e.count == 2 && e.forward != 1) p.consistent = false;
+  }
+  const Eigen::Vector3d o = mesh.properties.center_of_mass;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    pieces[find(static_cast<int>(t))].volume +=
+        (mesh.vertices[tri[0]] - o).dot((mesh.vertices[tri[1]] - o).cross(mesh.vertices[tri[2]] - o));
+  }
+  auto outward = [&](int t) {
+    const Piece& p = pieces[find(t)];
+    if (!p.consistent || p.border > 0.02 * p.edges) return 0;
+    return (p.volume > 0) - (p.volume < 0);
+  };
+
+  const double cos_flat = std::cos(flat_deg * M_PI / 180.0);
+  auto normal = [&](int t) {
+    const auto& tri = mesh.triangles[t];
+    return (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
+        .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]])
+        .normalized();
+  };
+  std::vector<std::array<int, 2>> out;
+  for (size_t ei = 0; ei < mesh.edges.size(); ++ei) {
+    pollStop(stop, ei, 1u << 14);
+    const auto& e = mesh.edges[ei];
+    const EdgeUse* use = useOf(e[0], e[1]);
+    if (use && use->count == 2) {
+      const int t1 = use->tris[0], t2 = use->tris[1];
+      const Eigen::Vector3d n1 = normal(t1);
+      if (std::abs(n1.dot(normal(t2))) >= cos_flat) continue;  // flat: the first contact there is a vertex's
+      // Concave (valley) edge of a solid: the free space around it is a wedge narrower than a
+      // half-space, which another edge can only touch along the valley, never across it; such
+      // contacts start at an end point (a vertex/patch test). Only ridges meet edge against edge.
+      if (const int out_sign = outward(t1)) {
+        int c = 0;  // the vertex of t2 off the edge
+        for (int k = 0; k < 3; ++k)
+          if (mesh.triangles[t2][k] != e[0] && mesh.triangles[t2][k] != e[1]) c = mesh.triangles[t2][k];
+        if (out_sign * n1.dot(mesh.vertices[c] - mesh.vertices[e[0]]) > 0) continue;
+      }
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
+MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius,
+                         const SphereIndexer& index_spheres, const StopSignal* stop) {
+  MeshModel m;
+  m.vertices.reserve(mesh.vertices.size());
+  m.bounds = aabbEmpty();
+  for (const auto& v : mesh.vertices) {
+    m.vertices.push_back(toV3(R * v));
+    aabbAdd(m.bounds, m.vertices.back());
+  }
+  m.triangles = mesh.triangles;
+  // The sphere model and its index are independent of the BVHs: built on a second thread
+  // (same result).
+  auto spheres = std::async(std::launch::async, [&] {
+    SphereModel sm = sampleSpheres(m.vertices, m.triangles, mesh.edges, sphere_radius, stop);
+    if (stop) stop->throwIfRequested();
+    if (index_spheres) index_spheres(sm, m.bounds);
+    return sm;
+  });
+  // A Stopped thrown here waits for the sphere thread (std::async's future), which stops too.
+  m.edges = featureEdges(mesh, 2.0, stop);
+  std::vector<Aabb> tri_boxes, edge_boxes, vert_boxes;
+  tri_boxes.reserve(m.triangles.size());
+  for (const auto& t : m.triangles) {
+    Aabb b = aabbEmpty();
+    for (int k = 0; k < 3; ++k) aabbAdd(b, m.vertices[t[k]]);
+    tri_boxes.push_back(b);
+    m.triangle_normals.push_back(normalized(
+        cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]])));
+  }
+  for (const auto& e : m.edges) {
+    Aabb b = aabbEmpty();
+    aabbAdd(b, m.vertices[e[0]]);
+    aabbAdd(b, m.vertices[e[1]]);
+    edge_boxes.push_back(b);
+  }
+  for (const auto& v : m.vertices) vert_boxes.push_back(Aabb{v, v});
+  if (stop) stop->throwIfRequested();
+  m.triangle_bvh = buildBvh(tri_boxes);
+  m.edge_bvh = buildBvh(edge_boxes);
+  m.vertex_bvh = buildBvh(vert_boxes);
+  m.spheres = spheres.get();
+  return m;
+}
+
+ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius, const StopSignal* stop) {
+  ObjectModel o;
+  // The object's spheres are reached through a BVH posed with the object.
+  static_cast<MeshModel&>(o) = buildMeshModel(
+      object_O, Eigen::Matrix3d::Identity(), sphere_radius, [](SphereModel& sm, const Aabb&) {
+        std::vector<Aabb> boxes;
+        boxes.reserve(sm.centres.size());
+        for (const V3& c : sm.centres) boxes.push_back(Aabb{c, c});
+        sm.bvh = buildBvh(boxes, 8);
+      },
+      stop);
+  o.com = toV3(object_O.properties.center_of_mass);
+  o.bounding_radius = object_O.properties.bounding_radius;
+  o.principal_axes = object_O.properties.principal_axes;
+  return o;
+}
+
+AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
+                         double collision_distance, double grid_cell, const StopSignal* stop) {
+  AreaModel a;
+  a.R_GW = gravityFrame(gravity_W);
+  // The area's spheres are reached through the height grid (V-B), not a BVH.
+  HeightGrid grid;
+  static_cast<MeshModel&>(a) = buildMeshModel(
+      area_W, a.R_GW, sphere_radius, [&](SphereModel& sm, const Aabb& bounds) {
+        grid = buildHeightGrid(sm, bounds, collision_distance, grid_cell, stop);
+      },
+      stop);
+  a.grid = std::move(grid);
+  a.source_triangles = area_W.triangles.size();
+  static std::atomic<uint64_t> next_id{1};
+  a.id = next_id++;
+  a.up_facing_share = upFacingShare(area_W, -gravity_W);
+  return a;
+}
+
+double rotationAngle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a.transpose() * b).angle();
+}
+
+double rotationAngle(const Rigid& a, const Rigid& b) {
+  return rotationAngle(toIsometry(a).linear(), toIsometry(b).linear());
+}
+
+}  // namespace place_planner

@@ -1,0 +1,81 @@
+// The search over roots (root_search.h).
+#include "place_planner/search/root_search.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace place_planner {
+
+std::vector<V3> orderFloorPoints(const std::vector<V3>& points, double spacing) {
+  if (points.empty()) return points;
+  V3 c = v3(0, 0, 0);
+  for (const V3& p : points) c = c + p;
+  c = (1.0 / points.size()) * c;
+  std::vector<std::pair<int, double>> key(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    int flat = 0;
+    for (const V3& q : points) {
+      const V3 d = q - points[i];
+      flat += d.x * d.x + d.y * d.y < 2.5 * spacing * spacing && std::abs(d.z) < 0.005;
+    }
+    const V3 dc = points[i] - c;
+    key[i] = {-flat, dc.x * dc.x + dc.y * dc.y};
+  }
+  std::vector<size_t> idx(points.size());
+  for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+  std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return key[a] < key[b]; });
+  std::vector<V3> sorted;
+  for (size_t i : idx) sorted.push_back(points[i]);
+  return sorted;
+}
+
+RootSearch::RootSearch(const std::vector<V3>& floor_points_G, const std::vector<StartOrientation>& orientations,
+                       const MeshProperties& object, const AreaModel& area, const V3& d_vis_G)
+    : floor_points_(floor_points_G), orientations_(orientations), com_O_(object.center_of_mass),
+      radius_(object.bounding_radius), d_vis_(d_vis_G) {
+  hmax_ = -kInf;
+  hmin_ = kInf;
+  for (const V3& v : area.vertices) {
+    hmax_ = std::max(hmax_, -dot(v, d_vis_));
+    hmin_ = std::min(hmin_, -dot(v, d_vis_));
+  }
+}
+
+double RootSearch::clearance(int root) const {
+  return hmax_ + dot(floor_points_[floorPoint(root)], d_vis_) + radius_ + 0.01;
+}
+
+Rigid RootSearch::pose(int root) const {
+  const Eigen::Matrix3d& R = orientations_[root % orientations_.size()].R_GO;
+  const Eigen::Vector3d com_G = toEigen(floor_points_[floorPoint(root)]) - clearance(root) * toEigen(d_vis_);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = R;
+  X.translation() = com_G - R * com_O_;
+  return toRigid(X);
+}
+
+double RootSearch::tmax(int root) const { return clearance(root) + radius_ + (hmax_ - hmin_) + 0.01; }
+
+}  // namespace place_planner
+
+namespace place_planner {
+
+void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O, int batch,
+                 std::vector<TreeLeaf>& leaves,
+                 const std::function<bool(int, int)>& after_step) {
+  int next = 0;
+  const int first_batch = std::max(4, batch / 6);
+  for (int step = 0, target = first_batch;; ++step) {
+    if (step > 0 && step % 2 == 0) target = std::min(batch, 2 * target);
+    while (static_cast<int>(stepper.active()) < target && next < roots.size()) {
+      stepper.addRoot(roots.pose(next), next, com_O, roots.d_vis(), roots.tmax(next));
+      ++next;
+    }
+    if (stepper.empty()) break;
+    stepper.step(leaves);
+    if (!after_step(next, static_cast<int>(stepper.openRoots().size()))) break;
+  }
+}
+
+}  // namespace place_planner

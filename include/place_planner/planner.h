@@ -106,6 +106,7 @@ struct PlanStats {
   StepTimes steps;
   double robustness_ms = 0.0;      // wall time of the robustness check
   std::string backend;             // "cpu" or "cuda"
+  std::string backend_note;        // why `auto` chose the CPU ("no usable GPU (...)"), else empty
   double sphere_radius = 0.0;      // as used (derived when the config says 0)
 };
 
@@ -146,6 +147,12 @@ using ProgressCallback = std::function<bool(const Progress&)>;
 
 class AreaModelCache;
 
+// Threads: one Planner may be shared by several threads at once (a robot with two arms, a node
+// serving goals while a preview plans). plan() is const; the only state it touches is the
+// area-model cache, whose lookups and insertions hold its mutex, and the models it hands out
+// are immutable and shared by reference count. Concurrent plans share the CPU worker pool: the
+// one that finds it busy runs its batch on its own thread, with the same answers
+// (test/core/test_threads.cpp, run under ThreadSanitizer by scripts/test).
 class Planner {
  public:
   Planner();

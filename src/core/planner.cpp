@@ -36,7 +36,6 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-std::once_flag g_backend_log;
 // Below this share of surface facing against gravity (within 20 degrees), the plan warns.
 constexpr double kMinUpFacingShare = 0.05;
 // With the robustness check on, the search stops at this share of the time budget.
@@ -60,16 +59,16 @@ Radii sphereRadii(const Mesh& object, const PlannerConfig& config) {
   return s;
 }
 
+// `note` says why `auto` ended on the CPU (no usable GPU): the normal case, so it is a note in the
+// stats for the caller to show (the CLI with -v, the node once in its log), not a warning.
 std::unique_ptr<Backend> chooseBackend(const ObjectModel& om, const AreaModel& am, const TiltParams& tilt,
-                                       const PlannerConfig& config) {
+                                       const PlannerConfig& config, std::string* note) {
   if (config.backend != BackendKind::kCpu) {
     std::string why;
     if (cuda::available(&why)) return makeCudaBackend(om, am, tilt);
     if (config.backend == BackendKind::kCuda)
       throw std::runtime_error("backend = cuda requested but unavailable: " + why);
-    std::call_once(g_backend_log, [&] {
-      std::fprintf(stderr, "[place_planner] no usable GPU (%s): using the CPU backend\n", why.c_str());
-    });
+    *note = "no usable GPU (" + why + "): the CPU backend";
   }
   return makeCpuBackend(om, am, tilt, config.threads);
 }
@@ -370,7 +369,7 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache) {
         decimationWarning("placement area mesh", am.source_triangles, am.triangles.size(), am.decimation_cell));
   warnAboutGravity(run.area, am, m.d_g_W, run.result);
   m.d_vis = toV3(am.R_GW * m.d_vis_W);
-  m.backend = chooseBackend(m.om, am, TiltParams{0.002, 1e-6 + 1e-4 * m.rad.r}, config);
+  m.backend = chooseBackend(m.om, am, TiltParams{0.002, 1e-6 + 1e-4 * m.rad.r}, config, &run.st().backend_note);
   run.st().backend = m.backend->name();
   return m;
 }

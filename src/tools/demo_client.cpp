@@ -17,6 +17,7 @@
 #include <string>
 
 #include "place_planner/PlacePlanAction.h"
+#include "place_planner/infra/output_file.h"
 #include "place_planner/ros/conversions.h"
 
 namespace {
@@ -132,7 +133,9 @@ int main(int argc, char** argv) {
   const int status = run(pnh);
   std::string report_file;
   if (pnh.getParam("report_file", report_file) && !report_file.empty()) {
-    std::ofstream(report_file) << g_report << "status " << status << "\n";
+    std::ostringstream report;
+    report << g_report << "status " << status << "\n";
+    place_planner::writeOutputFile(report_file, report.str());
   }
   return status;
 }

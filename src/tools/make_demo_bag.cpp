@@ -16,6 +16,7 @@
 #include <string>
 
 #include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/output_file.h"
 #include "place_planner/ros/conversions.h"
 #include "place_planner/infra/scenes.h"
 
@@ -58,7 +59,10 @@ int main(int argc, char** argv) {
     (*header)["type"] = ros::message_traits::datatype<pcl_msgs::PolygonMesh>();
     (*header)["md5sum"] = ros::message_traits::md5sum<pcl_msgs::PolygonMesh>();
     (*header)["message_definition"] = ros::message_traits::definition<pcl_msgs::PolygonMesh>();
-    rosbag::Bag bag(out, rosbag::bagmode::Write);
+    // The bag is written beside its destination and put in place by the output-file rules
+    // (infra/output_file.h): a bag half-written, or a device replaced, is never left behind.
+    place_planner::produceOutputFile(out, [&](const std::string& temp) {
+    rosbag::Bag bag(temp, rosbag::bagmode::Write);
     if (!area_frame.empty() && area_frame != "world") {
       geometry_msgs::TransformStamped T;
       T.header.stamp = stamp;
@@ -86,6 +90,7 @@ int main(int argc, char** argv) {
                   mesh.vertices.size(), mesh.patches.size(), frame.c_str());
     }
     bag.close();
+    });
     std::printf("wrote %s\n", out.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "make_demo_bag: %s\n", e.what());

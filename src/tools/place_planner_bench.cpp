@@ -8,11 +8,13 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <memory>
 #include <string>
 
+#include "place_planner/infra/output_file.h"
 #include "place_planner/infra/cuda_backend.h"
 #include "place_planner/search/floor_points.h"
 #include "place_planner/infra/mesh_io.h"
@@ -145,8 +147,28 @@ BENCHMARK(BM_DishRackCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTim
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) g_data = argv[++i];
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
+  // --benchmark_out=FILE follows the project's output-file rules (infra/output_file.h): Google
+  // Benchmark writes a temporary file beside it, which then replaces it (or is copied into a
+  // device or FIFO).
+  int out_arg = -1;
+  for (int i = 1; i < argc; ++i)
+    if (!std::strncmp(argv[i], "--benchmark_out=", 16)) out_arg = i;
+  try {
+    if (out_arg < 0) {
+      benchmark::Initialize(&argc, argv);
+      benchmark::RunSpecifiedBenchmarks();
+    } else {
+      place_planner::produceOutputFile(argv[out_arg] + 16, [&](const std::string& temp) {
+        std::string arg = "--benchmark_out=" + temp;
+        argv[out_arg] = arg.data();
+        benchmark::Initialize(&argc, argv);
+        benchmark::RunSpecifiedBenchmarks();
+      });
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "place_planner_bench: %s\n", e.what());
+    return 4;
+  }
   benchmark::Shutdown();
   return 0;
 }

@@ -1,8 +1,11 @@
 // place_planner_cli: plan placements of an object mesh on an area mesh from the shell.
-// Arguments by CLI11, the JSON answer by nlohmann::json, written atomically (a temporary file in
-// the destination's directory, then rename), so a reader never sees half a file.
+// Arguments by CLI11, the JSON answer by nlohmann::json, written by the project's output-file
+// rules (infra/output_file.h): a regular file is replaced atomically, a device or FIFO is written
+// in place, a symlink's target is replaced, "-" is standard output.
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include <chrono>
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
@@ -21,6 +24,7 @@
 #include "place_planner/infra/cuda_backend.h"
 #include "place_planner/manipulation/gripper.h"
 #include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/output_file.h"
 #include "place_planner/planner.h"
 #include "place_planner/infra/scenes.h"
 #ifdef PLACE_PLANNER_HAVE_VALIDATION
@@ -48,9 +52,12 @@ const char* kFooter =
     "--verify K: simulate the best K stable candidates in Bullet (released 2 mm above the pose;\n"
     "stayed = moved < 1 cm, turned < 5 deg) within what is left of --budget-ms; one that falls is\n"
     "moved behind the other stable candidates.\n"
-    "--json OUT is replaced atomically (a temporary file beside it, then rename).\n"
+    "--json OUT: a regular file is replaced atomically (a temporary file beside it, then\n"
+    "rename); a device, FIFO or socket (/dev/null, a named pipe) is written in place; a symlink's\n"
+    "target is replaced; --json - writes the JSON to stdout and the report to stderr.\n"
     "\n"
-    "The last line of stdout is always 'outcome: ...'. Exit codes:\n"
+    "The last line of the report is always 'outcome: ...' (stdout; stderr with --json -).\n"
+    "Exit codes:\n"
     "  0  stable candidates found (outcome stable, or timed_out_partial: a partial answer)\n"
     "  1  the search completed and nothing is stable (no_stable_pose)\n"
     "  2  bad input: unknown or malformed option, value out of range, unreadable mesh, --json\n"
@@ -155,60 +162,37 @@ std::string errnoText(const std::string& what, const std::string& path) {
   return what + " " + path + ": " + std::strerror(errno);
 }
 
-// The file is written whole or not at all: the text goes to a temporary file in the same
-// directory (so that rename is atomic: same file system), is flushed to disk, then renamed
-// over `path`. Concurrent writers each have their own temporary file; the last rename wins.
-class AtomicFile {
+// Progress on standard error while a plan runs longer than a second, when it is a terminal
+// (as the node's action feedback): floor points done, stable poses so far. One line, redrawn.
+class ProgressLine {
  public:
-  // Checks up front, before any planning, that `path` can be written: its directory accepts a
-  // new file and it is not a directory. Throws InputError.
-  explicit AtomicFile(std::string path) : path_(std::move(path)) {
-    struct stat st;
-    if (stat(path_.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-      throw InputError("--json: " + path_ + " is a directory");
-    const int fd = makeTemp();
-    if (fd < 0) throw InputError("--json: " + errnoText("cannot create a file beside", path_));
-    close(fd);
-    unlink(temp_.c_str());
+  ProgressLine() : enabled_(isatty(STDERR_FILENO) == 1) {}
+  ~ProgressLine() { finish(); }
+
+  bool operator()(const Progress& p) {
+    if (!enabled_ || p.elapsed_ms < 1000.0) return true;
+    const auto now = std::chrono::steady_clock::now();
+    if (shown_ && now - last_ < std::chrono::milliseconds(200)) return true;
+    last_ = now;
+    shown_ = true;
+    std::fprintf(stderr, "\rplanning: floor points %d of %d, %d stable so far, %.1f s\033[K", p.floor_points_done,
+                 p.floor_points_total, p.candidates, p.elapsed_ms / 1000.0);
+    std::fflush(stderr);
+    return true;
   }
 
-  // Throws OutputError; the destination is then as it was, and no temporary file is left.
-  void write(const std::string& text) {
-    const int fd = makeTemp();
-    if (fd < 0) throw OutputError(errnoText("cannot create a file beside", path_));
-    int err = 0;
-    // mkstemp creates 0600; give the file the mode a plain open() would (0666 less the umask).
-    const mode_t mask = umask(0);
-    umask(mask);
-    if (fchmod(fd, 0666 & ~mask) != 0) err = errno;
-    for (size_t done = 0; !err && done < text.size();) {
-      const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        err = n < 0 ? errno : EIO;
-      } else {
-        done += static_cast<size_t>(n);
-      }
-    }
-    if (!err && fsync(fd) != 0) err = errno;
-    if (close(fd) != 0 && !err) err = errno;
-    if (!err && rename(temp_.c_str(), path_.c_str()) != 0) err = errno;
-    if (!err) return;
-    unlink(temp_.c_str());
-    throw OutputError("cannot write " + path_ + ": " + std::strerror(err));
+  // Clears the line before the report is printed.
+  void finish() {
+    if (!shown_) return;
+    std::fprintf(stderr, "\r\033[K");
+    std::fflush(stderr);
+    shown_ = false;
   }
 
  private:
-  int makeTemp() {
-    std::vector<char> name(path_.begin(), path_.end());
-    for (char c : std::string(".tmp.XXXXXX")) name.push_back(c);
-    name.push_back('\0');
-    const int fd = mkstemp(name.data());
-    temp_ = name.data();
-    return fd;
-  }
-
-  std::string path_, temp_;
+  bool enabled_;
+  bool shown_ = false;
+  std::chrono::steady_clock::time_point last_;
 };
 
 Json vecJson(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
@@ -314,11 +298,12 @@ std::string robustnessCell(const Robustness& r) {
 void printReport(const std::string& object_spec, const Mesh& object, const std::string& area_spec,
                  const Mesh& area, const PlannerConfig& c, const PlanResult& r) {
   const auto& st = r.stats;
-  std::printf("object %s (%zu triangles), area %s (%zu triangles), backend %s, orientation %s\n",
-              object_spec.c_str(), object.triangles.size(), area_spec.c_str(), area.triangles.size(),
-              st.backend.c_str(), toString(c.orientation).c_str());
-  std::printf("floor points %d of %d, tree nodes %ld, planning %.1f ms, first stable %.1f ms\n",
-              st.floor_points_done, st.floor_points_total, st.tree_nodes, st.total_ms, st.first_stable_ms);
+  std::printf("object %s (%zu triangles), area %s (%zu triangles), orientation %s\n", object_spec.c_str(),
+              object.triangles.size(), area_spec.c_str(), area.triangles.size(), toString(c.orientation).c_str());
+  // The times block names the backend once: the CPU is the normal case for `auto`, not a warning.
+  std::printf("floor points %d of %d, tree nodes %ld, planning %.1f ms, first stable %.1f ms, %s backend\n",
+              st.floor_points_done, st.floor_points_total, st.tree_nodes, st.total_ms, st.first_stable_ms,
+              st.backend == "cuda" ? "CUDA" : "CPU");
   if (st.trees_without_rest > 0 || st.roll_bottoms > 0 || st.trees_fallen > 0)
     std::printf("trees: %d cut by max_rotations while still tilting, %d ended at the bottom of a roll, "
                 "%d cut while falling over a ledge\n",
@@ -371,6 +356,25 @@ void printOutcome(const PlannerConfig& c, const PlanResult& r) {
   }
 }
 
+// The JSON answer by the output-file rules, or to `json_fd` (standard output) for "-".
+// Throws OutputError (exit 4).
+void writeJson(const std::string& path, int json_fd, const std::string& text) {
+  if (json_fd >= 0) {
+    for (size_t done = 0; done < text.size();) {
+      const ssize_t n = ::write(json_fd, text.data() + done, text.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) throw OutputError(std::string("cannot write the JSON to standard output: ") + std::strerror(n < 0 ? errno : EIO));
+      done += static_cast<size_t>(n);
+    }
+    return;
+  }
+  try {
+    writeOutputFile(path, text);
+  } catch (const std::runtime_error& e) {
+    throw OutputError(e.what());
+  }
+}
+
 int fail(int code, const std::string& outcome, const std::string& what) {
   std::fflush(stdout);
   std::fprintf(stderr, "place_planner_cli: error: %s\n", what.c_str());
@@ -388,6 +392,7 @@ int main(int argc, char** argv) {
 
   PlannerConfig c;
   std::string object_spec, area_spec, json_path;
+  int json_fd = -1;  // --json -: the original standard output
   bool auto_gravity = false, no_robust_check = false;
   int verify_k = 0;
 
@@ -454,7 +459,10 @@ int main(int argc, char** argv) {
   app.add_option("--verify", verify_k, "physics check of the best K stable candidates, 0 = off")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--json", json_path, "write the answer as JSON to this file")->type_name("OUT");
+  app.add_option("--json", json_path, "write the answer as JSON to this file; - = stdout (the report then goes to stderr)")
+      ->type_name("OUT");
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "also say why the CPU backend was chosen (no usable GPU)");
   // Bounded work (README "Bounded work"): the limits of PlannerConfig.
   app.add_option("--max-triangles", c.max_triangles, "per mesh; larger ones are decimated")->capture_default_str();
   app.add_option("--max-floor-points", c.max_floor_points, "rays cast; a finer spacing is coarsened")
@@ -526,6 +534,12 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
+    // --json -: the JSON keeps standard output; everything else printed goes to standard error.
+    if (json_path == "-") {
+      std::fflush(stdout);
+      json_fd = dup(STDOUT_FILENO);
+      if (json_fd < 0 || dup2(STDERR_FILENO, STDOUT_FILENO) < 0) return fail(kExitOutputError, "output_error", "--json -: cannot redirect the report");
+    }
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help
     return fail(kExitBadInput, "bad_input", std::string(e.what()) + " (see --help)");
@@ -557,8 +571,16 @@ int main(int argc, char** argv) {
         throw InputError("--backend " + backend_name + ": the CUDA backend is unavailable (" + why + ")");
     }
     // Before planning: a typo in the output path should not cost the plan.
-    std::unique_ptr<AtomicFile> json_file;
-    if (!json_path.empty()) json_file = std::make_unique<AtomicFile>(json_path);
+    if (!json_path.empty() && json_path != "-") {
+      try {
+        const OutputTarget t = resolveOutput(json_path);
+        const std::string dir = t.path.substr(0, t.path.rfind('/') == std::string::npos ? 0 : t.path.rfind('/') + 1);
+        if (t.kind == OutputTarget::Kind::kReplace && access(dir.empty() ? "." : dir.c_str(), W_OK) != 0)
+          throw std::runtime_error(errnoText("cannot create a file in the directory of", json_path));
+      } catch (const std::runtime_error& e) {
+        throw InputError(std::string("--json: ") + e.what());
+      }
+    }
     const Mesh object = load("--object", object_spec);
     const Mesh area = load("--area", area_spec);
     if (auto_gravity) {
@@ -568,7 +590,10 @@ int main(int argc, char** argv) {
       std::printf("gravity (auto): (%.3f, %.3f, %.3f), the largest flat region being %.0f %% of the area\n",
                   c.gravity.x(), c.gravity.y(), c.gravity.z(), 100 * e.share);
     }
-    r = Planner().plan(object, area, c);
+    ProgressLine progress;
+    r = Planner().plan(object, area, c, [&](const Progress& p) { return progress(p); });
+    progress.finish();
+    if (verbose && !r.stats.backend_note.empty()) std::fprintf(stderr, "note: %s\n", r.stats.backend_note.c_str());
     for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     printReport(object_spec, object, area_spec, area, c, r);
 #ifdef PLACE_PLANNER_HAVE_VALIDATION
@@ -582,11 +607,12 @@ int main(int argc, char** argv) {
     }
 #endif
     printTable(r);
-    if (json_file) {
+    if (!json_path.empty()) {
       // Invalid UTF-8 in a path (any bytes are legal there) becomes U+FFFD rather than an
       // exception: the answer is still written.
-      json_file->write(resultJson(object_spec, area_spec, c, r).dump(-1, ' ', false, Json::error_handler_t::replace) +
-                       "\n");
+      const std::string text =
+          resultJson(object_spec, area_spec, c, r).dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+      writeJson(json_path, json_fd, text);
     }
   } catch (const OutputError& e) {
     return fail(kExitOutputError, "output_error", e.what());

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/output_file.h"
 #include "place_planner/validation/mesh_variants.h"
 #include "place_planner/validation/plot.h"
 #include "place_planner/validation/suite.h"
@@ -221,7 +222,7 @@ int main(int argc, char** argv) {
 
   if (do_fig6 && !data.empty()) {
     const std::vector<Fig6Row> rows = fig6(data, cfg);
-    std::ofstream csv(out + "/fig6.csv");
+    std::ostringstream csv;  // written whole below (infra/output_file.h)
     csv << "triangles,setup,floor_points,first_contact,contact_points,tilt_vertex,tilt_edge,stability,"
            "local_optimisation,total_ms,per_floor_point_ms\n";
     md << "Time per planner step (ms, median of 3) against object triangles, YCB mug decimated by "
@@ -251,6 +252,7 @@ int main(int argc, char** argv) {
       for (size_t k = 0; k < ser.size(); ++k) ser[k].y.push_back(v[k]);
     }
     md << "\n";
+    place_planner::writeOutputFile(out + "/fig6.csv", csv.str());
     plotLines(plots + "/fig6_step_times.png",
               "Planner time per step vs object triangles (mug on books_stack)",
               "object triangles (vertex clustering of the 16k YCB mug)", "ms (median of 3)", x, ser);
@@ -260,7 +262,7 @@ int main(int argc, char** argv) {
   for (size_t k = 0; k < holes.size(); ++k)
     md << "Per scene, " << static_cast<int>(std::lround(holes[k] * 100)) << "% holes:\n\n"
        << markdownTable(holey[k]) << "\n";
-  std::ofstream(out + "/results.md") << md.str();
+  place_planner::writeOutputFile(out + "/results.md", md.str());
   std::cout << md.str().substr(0, md.str().find("\n\n")) << "\n";
   return sf.errors == sf.scenes ? 1 : 0;
 }

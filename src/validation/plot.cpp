@@ -1,4 +1,5 @@
 #include "place_planner/validation/plot.h"
+#include "place_planner/infra/output_file.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -86,8 +87,12 @@ void legend(Frame& f, const std::vector<Series>& series) {
   }
 }
 
+// By the output-file rules (infra/output_file.h): imwrite writes a temporary file beside the
+// target (same extension: the format), which then replaces it.
 void save(const std::string& path, const cv::Mat& img) {
-  if (!cv::imwrite(path, img)) throw std::runtime_error("cannot write " + path);
+  produceOutputFile(path, [&](const std::string& temp) {
+    if (!cv::imwrite(temp, img)) throw std::runtime_error("cannot write " + path);
+  });
 }
 
 }  // namespace

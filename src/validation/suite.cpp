@@ -1,5 +1,7 @@
 #include "place_planner/validation/suite.h"
 
+#include "place_planner/infra/output_file.h"
+
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -239,8 +241,9 @@ SuiteSummary summarize(const std::vector<SceneResult>& results) {
 }
 
 void writeScenesCsv(const std::vector<SceneResult>& results, const std::string& path) {
-  std::ofstream os(path);
-  if (!os) throw std::runtime_error("cannot write " + path);
+  // Written whole by the output-file rules (infra/output_file.h): never half a file, never a
+  // device replaced.
+  std::ostringstream os;
   os << "scene,variant,object_triangles,area_triangles,floor_points,total_ms,first_stable_ms,"
         "ms_setup,ms_floor_points,ms_first_contact,ms_contact_points,ms_tilt_vertex,ms_tilt_edge,"
         "ms_stability,ms_local_optimisation,candidates,stable,validated,confirmed,precision,"
@@ -258,11 +261,13 @@ void writeScenesCsv(const std::vector<SceneResult>& results, const std::string& 
        << r.drop_ms_median << ',' << r.planner_ms_per_floor_point << ',' << r.speedup() << ",\""
        << r.error << "\"\n";
   }
+  writeOutputFile(path, os.str());
 }
 
 void writeChecksCsv(const std::vector<SceneResult>& results, const std::string& path) {
-  std::ofstream os(path);
-  if (!os) throw std::runtime_error("cannot write " + path);
+  // Written whole by the output-file rules (infra/output_file.h): never half a file, never a
+  // device replaced.
+  std::ostringstream os;
   os << "scene,variant,rank,quality,confirmed,moved_m,turned_deg,aborted,"
         "goal_x,goal_y,goal_z,goal_qw,goal_qx,goal_qy,goal_qz,"
         "final_x,final_y,final_z,final_qw,final_qx,final_qy,final_qz\n";
@@ -276,11 +281,13 @@ void writeChecksCsv(const std::vector<SceneResult>& results, const std::string& 
       poseCsv(os, c.check.X_WO_final);
       os << '\n';
     }
+  writeOutputFile(path, os.str());
 }
 
 void writeDropsCsv(const std::vector<SceneResult>& results, const std::string& path) {
-  std::ofstream os(path);
-  if (!os) throw std::runtime_error("cannot write " + path);
+  // Written whole by the output-file rules (infra/output_file.h): never half a file, never a
+  // device replaced.
+  std::ostringstream os;
   os << "scene,variant,floor_point,at_rest,fell_off,steps,sim_s,wall_ms,"
         "start_x,start_y,start_z,start_qw,start_qx,start_qy,start_qz,"
         "rest_x,rest_y,rest_z,rest_qw,rest_qx,rest_qy,rest_qz\n";
@@ -294,6 +301,7 @@ void writeDropsCsv(const std::vector<SceneResult>& results, const std::string& p
       poseCsv(os, d.result.X_WO_rest);
       os << '\n';
     }
+  writeOutputFile(path, os.str());
 }
 
 std::string markdownTable(const std::vector<SceneResult>& results) {

@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -292,7 +294,7 @@ TEST(PlacePlannerCli, BackendGpuIsCudaOrAnError) {
     } else {
       EXPECT_EQ(r.code, 2) << name << ": " << r.out;
       EXPECT_TRUE(contains(r.err, "--backend " + name + ": the CUDA backend is unavailable")) << r.err;
-      EXPECT_FALSE(contains(r.out, "backend cpu")) << "planned on the CPU anyway";
+      EXPECT_FALSE(contains(r.out, "CPU backend")) << "planned on the CPU anyway";
     }
     std::remove(path.c_str());
   }
@@ -374,6 +376,99 @@ TEST(PlacePlannerCli, WriteFailureExitsFourAndKeepsTheOldFile) {
   EXPECT_EQ(listDir(dir), std::vector<std::string>{"out.json"}) << "temporary files left behind";
   std::remove(path.c_str());
   rmdir(dir.c_str());
+}
+
+// The output-file rules (infra/output_file.h) as a user meets them: a device, a FIFO, a symlink,
+// "-" and a directory given to --json each end as documented, never replaced by a regular file.
+TEST(PlacePlannerCli, JsonToACharacterDeviceWritesInPlace) {
+  const std::string dir = tempDir("device");
+  const std::string null_dev = dir + "/null", full_dev = dir + "/full";
+  // Private copies of /dev/null (1,3) and /dev/full (1,7): the real ones are never risked.
+  if (mknod(null_dev.c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0 ||
+      mknod(full_dev.c_str(), S_IFCHR | 0666, makedev(1, 7)) != 0) {
+    rmdir(dir.c_str());
+    GTEST_SKIP() << "mknod needs root (CAP_MKNOD): " << std::strerror(errno);
+  }
+  const CliRun ok = cli(cubeOnTable({"--no-robust-check", "--json", null_dev}));
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  const CliRun full = cli(cubeOnTable({"--no-robust-check", "--json", full_dev}));
+  EXPECT_EQ(full.code, 4) << full.err;
+  EXPECT_EQ(full.last_line, "outcome: output_error");
+  EXPECT_TRUE(contains(full.err, "No space left on device")) << full.err;
+  for (const std::string& d : {null_dev, full_dev}) {
+    struct stat st;
+    ASSERT_EQ(lstat(d.c_str(), &st), 0) << d;
+    EXPECT_TRUE(S_ISCHR(st.st_mode)) << d << " is no longer a character device";
+    std::remove(d.c_str());
+  }
+  EXPECT_TRUE(listDir(dir).empty()) << "temporary files left behind";
+  rmdir(dir.c_str());
+}
+
+TEST(PlacePlannerCli, JsonToAFifoReachesItsReader) {
+  const std::string dir = tempDir("fifo");
+  const std::string fifo = dir + "/answer";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  std::string got;
+  std::thread reader([&] { got = readFile(fifo); });  // opens (blocks) until the CLI writes
+  const CliRun r = cli(cubeOnTable({"--no-robust-check", "--json", fifo}));
+  reader.join();
+  EXPECT_EQ(r.code, 0) << r.err;
+  ASSERT_TRUE(json::accept(got)) << "the reader got: " << got.substr(0, 200);
+  EXPECT_EQ(json::parse(got).at("outcome"), "stable");
+  struct stat st;
+  ASSERT_EQ(lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the FIFO was replaced";
+  std::remove(fifo.c_str());
+  EXPECT_TRUE(listDir(dir).empty()) << "temporary files left behind";
+  rmdir(dir.c_str());
+}
+
+TEST(PlacePlannerCli, JsonThroughASymlinkReplacesItsTarget) {
+  const std::string dir = tempDir("symlink");
+  mkdir((dir + "/results").c_str(), 0755);
+  const std::string target = dir + "/results/run1.json", link = dir + "/out.json";
+  std::ofstream(target) << "{\"old\": true}\n";
+  ASSERT_EQ(symlink("results/run1.json", link.c_str()), 0);
+  const CliRun r = cli(cubeOnTable({"--no-robust-check", "--json", link}));
+  EXPECT_EQ(r.code, 0) << r.err;
+  struct stat st;
+  ASSERT_EQ(lstat(link.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISLNK(st.st_mode)) << "the link was replaced by a file";
+  const json j = json::parse(readFile(target));
+  EXPECT_EQ(j.at("outcome"), "stable") << "the target keeps the old answer";
+  EXPECT_EQ(listDir(dir + "/results"), std::vector<std::string>{"run1.json"}) << "temporary files left";
+  std::remove(link.c_str());
+  std::remove(target.c_str());
+  rmdir((dir + "/results").c_str());
+  rmdir(dir.c_str());
+}
+
+TEST(PlacePlannerCli, JsonDashGoesToStdoutAndTheReportToStderr) {
+  const CliRun r = cli(cubeOnTable({"--no-robust-check", "--json", "-"}));
+  EXPECT_EQ(r.code, 0) << r.err;
+  ASSERT_TRUE(json::accept(r.out)) << "stdout is not the JSON alone: " << r.out.substr(0, 200);
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j.at("outcome"), "stable");
+  EXPECT_GT(j.at("candidates").size(), 0u);
+  EXPECT_TRUE(contains(r.err, "outcome: stable")) << r.err;
+  EXPECT_TRUE(contains(r.err, "floor points")) << r.err;
+}
+
+// The CPU is the normal case for `auto`: named once in the times block, no warning; -v says why.
+TEST(PlacePlannerCli, CpuBackendIsNamedOnceAndNotAWarning) {
+  std::string why;
+  if (cuda::available(&why)) GTEST_SKIP() << "a GPU is usable here: auto plans on CUDA";
+  const CliRun r = cli(cubeOnTable({"--no-robust-check"}));
+  EXPECT_EQ(r.code, 0) << r.err;
+  size_t n = 0;
+  for (size_t at = r.out.find("CPU backend"); at != std::string::npos; at = r.out.find("CPU backend", at + 1)) ++n;
+  EXPECT_EQ(n, 1u) << r.out;
+  EXPECT_FALSE(contains(r.err, "GPU")) << r.err;
+  EXPECT_FALSE(contains(r.err, "warning")) << r.err;
+  const CliRun v = cli(cubeOnTable({"--no-robust-check", "-v"}));
+  EXPECT_EQ(v.code, 0) << v.err;
+  EXPECT_TRUE(contains(v.err, "no usable GPU")) << v.err;
 }
 
 // Paths are bytes: quotes, backslashes and control characters are escaped; bytes that are not

@@ -283,7 +283,7 @@ class OneResultPerGoal(unittest.TestCase):
         y = self.new_id("cancel-while-planning")
         self.send_goal(y, long_goal())
         self.wait_active(y)
-        time.sleep(0.05)
+        time.sleep(0.3)  # well into the plan (about 8 s uncancelled), not its first moments
         self.send_cancel(y)
         self.wait_result(y, 5.0)
         expected[y] = (preempted, False)

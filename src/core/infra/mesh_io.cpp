@@ -1,4 +1,5 @@
 #include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/output_file.h"
 
 #include <algorithm>
 #include <cctype>
@@ -353,8 +354,8 @@ Mesh loadMesh(const std::string& path) {
 }
 
 void saveMeshPly(const Mesh& mesh, const std::string& path, bool binary) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) fail(path, "cannot write file");
+  // Built in memory, then written by the output-file rules (output_file.h).
+  std::ostringstream out(std::ios::binary);
   out.precision(std::numeric_limits<double>::max_digits10);  // ASCII: the doubles exactly
   // A list length of a byte holds 255: longer patches (a cylinder's cap of 256 sides) need more.
   size_t longest = 0;
@@ -391,8 +392,11 @@ void saveMeshPly(const Mesh& mesh, const std::string& path, bool binary) {
       out << '\n';
     }
   }
-  out.close();
-  if (!out) fail(path, "write failed");
+  try {
+    writeOutputFile(path, out.str());
+  } catch (const std::runtime_error& e) {
+    fail(path, e.what());
+  }
 }
 
 }  // namespace place_planner

@@ -1,4 +1,4 @@
-# Bullet physics validation, the drop-and-settle baseline and the benchmark suite (issue 5).
+# Bullet physics validation, the drop-and-settle baseline and the benchmark suite.
 # Included by CMakeLists.txt after catkin_package(). Bullet is used here only: never in the core.
 
 # The Find module (not Debian's BulletConfig.cmake, whose paths are relative) gives absolute paths.

@@ -47,13 +47,13 @@ struct PlannerConfig {
   bool robust_check = true;                  // false: static stability only (the paper)
   // Tilted releases caught where they land (3.5 deg off, stable, tipping margin >= 20 deg) also
   // hold when that pose holds its own shift and centre-of-mass trials: more poses on domed
-  // supports (peg tops), at a measured cost in precision (README, "Caught tilted trials").
+  // supports (peg tops), at a measured cost in precision (doc/method.md).
   bool robust_recheck_caught = false;
   // Rock settle (tree_stepper.cpp): a pose the static test holds is rocked 1 degree about the
   // horizontal axes through its centre of mass and moves where that lowers it, so a tilted
-  // release on domes, rims or a dish's underside comes back to its rest. On by default since
-  // session 7: with Bullet in its scaled world and the wedge rule it lifts the coverage of the
-  // 56 1k scenes from 32/39 to 36/38 at a precision of 0.981 (README, "Rock settle").
+  // release on domes, rims or a dish's underside comes back to its rest. On by default: with
+  // the wedge rule it lifts the coverage of the 56 1k scenes from 32/39 to 36/38 at a precision
+  // of 0.981 in Bullet (doc/method.md, "Rock settle").
   bool rock_settle = true;
   double time_budget_ms = 0.0;               // 0 = no budget
   int max_candidates = 10;                   // after ranking and merging

@@ -232,7 +232,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("robust_recheck_caught", &p.robust_recheck_caught);
   r.read("rock_settle", &p.rock_settle);
   // The budget is in seconds like every time of the ROS interface (doc/node.md, "Units"); the
-  // core's field is in ms. time_budget_ms (before issue 10) is still read, with a warning.
+  // core's field is in ms. time_budget_ms (the older name) is still read, with a warning.
   double budget_s = p.time_budget_ms / 1000.0;
   r.read("time_budget_s", &budget_s);
   if (r.has("time_budget_ms")) {
@@ -262,7 +262,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("backend", &backend);
   r.read("region_min", &p.region_min);
   r.read("region_max", &p.region_max);
-  // Bounded work (issue 10).
+  // Bounded work.
   r.read("max_triangles", &p.max_triangles);
   r.read("max_floor_points", &p.max_floor_points);
   double max_tree_nodes = static_cast<double>(p.max_tree_nodes);  // a long; YAML ints are 32 bit
@@ -275,7 +275,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("max_model_mb", &p.max_model_mb);
   r.read("max_object_size", &p.max_object_size);
   r.read("max_area_size", &p.max_area_size);
-  // Manipulation (issue 11). has_grasp and grasp come with each goal.
+  // Manipulation. has_grasp and grasp come with each goal.
   r.read("max_gripper_tilt_deg", &p.max_gripper_tilt_deg);
   r.read("gripper_min_clearance", &p.gripper_min_clearance);
   r.read("keep_colliding", &p.keep_colliding);

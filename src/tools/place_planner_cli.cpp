@@ -36,7 +36,7 @@ using Json = nlohmann::ordered_json;  // keys in the order written, as a reader 
 
 namespace {
 
-// Exit codes (README "Command line"; also in --help).
+// Exit codes (doc/cli.md; also in --help).
 constexpr int kExitStable = 0;       // stable candidates (search complete, or a partial answer)
 constexpr int kExitNoStable = 1;     // search complete, nothing stable
 constexpr int kExitBadInput = 2;     // bad option, value out of range, unreadable mesh, unwritable --json
@@ -463,7 +463,7 @@ int main(int argc, char** argv) {
       ->type_name("OUT");
   bool verbose = false;
   app.add_flag("-v,--verbose", verbose, "also say why the CPU backend was chosen (no usable GPU)");
-  // Bounded work (README "Bounded work"): the limits of PlannerConfig.
+  // Bounded work (doc/reliability.md): the limits of PlannerConfig.
   app.add_option("--max-triangles", c.max_triangles, "per mesh; larger ones are decimated")->capture_default_str();
   app.add_option("--max-floor-points", c.max_floor_points, "rays cast; a finer spacing is coarsened")
       ->capture_default_str();

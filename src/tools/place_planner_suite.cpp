@@ -1,4 +1,4 @@
-// The benchmark suite of issue 5 (scripts/bench runs it): every object x area pair, planner and
+// The benchmark suite (scripts/bench runs it): every object x area pair, planner and
 // Bullet in this one process. Writes scenes.csv, checks.csv, drops.csv, fig6.csv, results.md
 // and the PNG plots.
 //
@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
     else if (a == "--threads") cfg.planner.threads = std::stoi(next());
     else if (a == "--friction") cfg.planner.friction = std::stod(next());
     else if (a == "--auto-gravity") cfg.auto_gravity = true;
-    // Planner options, to measure their effect on precision and coverage (issue 9).
+    // Planner options, to measure their effect on precision and coverage.
     else if (a == "--orientation") cfg.planner.orientation = orientationModeFromString(next());
     else if (a == "--robust-shift") cfg.planner.robust_shift = std::stod(next());
     else if (a == "--robust-tilt-deg") cfg.planner.robust_tilt_deg = std::stod(next());

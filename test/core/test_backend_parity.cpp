@@ -1,4 +1,4 @@
-// nvblox style (issue 12): the CUDA backend gives the CPU backend's answers, kernel by kernel
+// nvblox style: the CUDA backend gives the CPU backend's answers, kernel by kernel
 // and plan by plan. The query sets are checked on the CPU first (they must hit), so the parity
 // tests cannot pass on queries that find nothing. Without a GPU they skip and say why.
 #include <Eigen/Geometry>

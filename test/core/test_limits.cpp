@@ -1,4 +1,4 @@
-// Issue 10: bounded work on any input. Each limit is checked before the work it bounds and
+// bounded work on any input. Each limit is checked before the work it bounds and
 // gives a named error or a reported automatic step; a cancel and the budget reach the setup.
 #include <Eigen/Geometry>
 #include <chrono>

@@ -235,7 +235,7 @@ TEST(Planner, MergesNearbyPoses) {
 // ------------------------------------------------------------------ real meshes
 TEST(PlannerShared, PlateStandsInDishRack) {
   PP_REQUIRE_SHARED_DATA();
-  GTEST_SKIP() << "known gap of issue 9 (measured in session 6): in principal_axis mode the plates that "
+  GTEST_SKIP() << "known gap (doc/validation.md): in principal_axis mode the plates that "
                   "end standing are wedged diagonally between peg sides, none statically stable (94 trees "
                   "still tilting at max_rotations 5, none at 12, still none standing); in auto mode the "
                   "standing ones lean on the rack's wall and fail their tilted trials; see the closing note";

@@ -1,4 +1,4 @@
-// Issue 9: the orientation search (resting faces, full tilt range), robust stability and
+// the orientation search (resting faces, full tilt range), robust stability and
 // stability against gravity. Each test asserts that work was done before the property.
 #include <Eigen/Geometry>
 #include <map>
@@ -253,7 +253,7 @@ TEST(Search, MugOnTableWithDefaultsStandsOnItsBase) {
 }
 
 // The scanned marker (a 12-gon-like hull, crests 0.1-0.2 mm high either way of a facet) on the
-// three areas issue 9 names, default options: the best candidate lies on its side, stable and
+// three flat areas (table, books_stack, bin), default options: the best candidate lies on its side, stable and
 // robust (it once got no stable candidate at all: a roll bottom needed 0.5 mm crests).
 TEST(Search, MarkerLiesStableWithDefaults) {
   PP_REQUIRE_SHARED_DATA();

@@ -1,4 +1,4 @@
-// Issue 11: the gripper from a URDF, its clearance, approach and retreat. Collisions are
+// the gripper from a URDF, its clearance, approach and retreat. Collisions are
 // confirmed by an independent brute-force query written here (no BVH, sampled points and
 // edge crossings), not by the planner's own check.
 #include <gtest/gtest.h>

@@ -44,7 +44,7 @@ constexpr double kSameQuality = 0.03;
 constexpr double kExact = 1e-6;
 // A vertex resting on the area (the planner's contact tolerance is well below this).
 constexpr double kOnSurface = 2e-3;
-// Cancel (or a newer goal) must end the running goal within 0.5 s (issue 10), measured at the
+// Cancel (or a newer goal) must end the running goal within 0.5 s, measured at the
 // client on this 2-core machine while others build on it; measured: about 10 ms.
 constexpr double kCancelLatency = 0.5;
 // Feedback is promised every 100 ms; allow scheduling jitter on a loaded 2-core CI machine.
@@ -797,7 +797,7 @@ TEST(PlacePlannerNode, VerifyTopKChecksTheBestTwoStableCandidates) {
   }
 }
 
-// ---------------------------------------------------------------- manipulation (issue 11)
+// ---------------------------------------------------------------- manipulation
 // The node runs with the test gripper (test/gripper/test_gripper.urdf through robot_description,
 // place_planner_node.test): palm, fingers 2.2 cm off the middle, a camera.
 

@@ -231,7 +231,7 @@ TEST(PrepareGoal, FlaggedZeroIsReallyZero) {
 
 TEST(PrepareGoal, ValuesAreUsedWithOrWithoutFlagAndBudgetIsSeconds) {
   PlacePlanGoal g = goal();
-  // Without flags, as goals before issue 10 set them.
+  // Without flags, as older goals set them.
   g.friction = 0.6;
   g.floor_point_spacing = 0.02;
   g.max_rotations = 2;
@@ -344,7 +344,7 @@ TEST(PrepareGoal, EmptyMeshTakesTheTopicsOrIsNoMesh) {
   EXPECT_NEAR(p.area_W.properties.bounds_max.z(), 0.0, kFloat32);
 }
 
-// ---------------------------------------------------------------- shape_msgs/Mesh (issue 11)
+// ---------------------------------------------------------------- shape_msgs/Mesh
 TEST(ShapeMsgs, MeshConvertsVertexForVertexAndNamesABadIndex) {
   shape_msgs::Mesh m;
   toMsg(object(), &m);
@@ -407,7 +407,7 @@ TEST(ShapeMsgs, GoalShapesAreUsedWhenThePolygonMeshesAreEmpty) {
   EXPECT_NEAR(q.area_W.properties.bounds_max.y(), 0.25, 1e-9);
 }
 
-// ---------------------------------------------------------------- manipulation fields (issue 11)
+// ---------------------------------------------------------------- manipulation fields
 TEST(PrepareGoal, ManipulationFieldsReachTheConfig) {
   PlacePlanGoal g = goal();
   NodeConfig np = params();

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""launch/place_planner.launch respawns the node (issue 10): killed, it comes back as a new
+"""launch/place_planner.launch respawns the node: killed, it comes back as a new
 process after respawn_delay and answers goals, and the launch (this test runs in it) lives on;
 with required="true" roslaunch would have taken this test down with the node."""
 import math

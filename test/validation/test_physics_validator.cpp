@@ -255,7 +255,7 @@ TEST(PhysicsValidator, CrackerBoxInDividedTrayBestCandidatesStayPut) {
   EXPECT_EQ(checked, 5);
 }
 
-// ---------------------------------------------------------------- verifyTopK (issue 9)
+// ---------------------------------------------------------------- verifyTopK
 
 // The cube on the built-in table, planned from the principal axis (any core: it rests on a face).
 PlannerConfig cubePlanConfig() {

@@ -1,4 +1,4 @@
-// Smoke version of the benchmark suite (issue 5, item 5): a few scenes, planner and Bullet in
+// Smoke version of the benchmark suite: a few scenes, planner and Bullet in
 // this process; fails when the planner's stable poses stop being confirmed by physics.
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@ namespace place_planner {
 namespace validation {
 namespace {
 
-// Issue 9: confirmed-stable precision >= 0.95 on the smoke scenes (measured 1.0: 35 of 35 with
+// confirmed-stable precision >= 0.95 on the smoke scenes (measured 1.0: 35 of 35 with
 // the robustness check; the full suite's figures are in doc/validation.md).
 constexpr double kMinSmokePrecision = 0.95;
 

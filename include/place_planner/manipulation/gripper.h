@@ -1,4 +1,4 @@
-// The gripper that holds the object (beyond the paper, issue 11): the collision geometry of
+// The gripper that holds the object (beyond the paper): the collision geometry of
 // the robot's gripper links, from its URDF, as one triangle mesh in the frame F of the first
 // link named. Convention: F's z axis is the approach axis, pointing from the palm to the
 // fingertips; the grasp X_OF places F in the object frame O (the goal's `grasp`).

@@ -1,4 +1,4 @@
-// Can a robot execute a candidate (beyond the paper, issue 11)? The straight approach along
+// Can a robot execute a candidate (beyond the paper)? The straight approach along
 // d_vis to the goal, the gripper (gripper.h) riding with the object through the approach, the
 // intermediate poses and the goal, and the gripper's retreat along -z of its frame F once it
 // lets go. Maps one to one onto moveit_msgs/PlaceLocation (doc/manipulation.md).

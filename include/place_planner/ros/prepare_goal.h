@@ -76,7 +76,7 @@ using FrameLookup = std::function<Eigen::Isometry3d(const std::string& frame)>;
 // out of range, a non-unit quaternion, a bad region: names the field, e.g. "goal: friction = -1
 // is out of range (0 <= friction <= 10)"). The use_* rules of the overrides are those of
 // PlacePlan.action: flag true -> the value as given (0 is 0); flag false -> the parameter when
-// the value is 0 or NaN, the value otherwise (goals before issue 10).
+// the value is 0 or NaN, the value otherwise (older goals, sent before the flags existed).
 // added_W (optional): objects placed earlier (add_to_area), in W, merged into the placement
 // area. The goal's mesh wins over its shape, which wins over the topics.
 PreparedGoal prepareGoal(const PlacePlanGoal& goal, const TopicMeshes& topics,

@@ -51,7 +51,7 @@ struct ValidatorConfig {
   double piece_max_normal_deg = 40.0;    // piece triangles' normals within this of the seed's
   double piece_max_size = 0.05;          // m, largest distance of a piece triangle from its seed
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2, world frame
-  // Stability check (issue 5): simulate `settle_time` from the goal pose, released `release_gap`
+  // Stability check: simulate `settle_time` from the goal pose, released `release_gap`
   // above it (against gravity: a body started exactly in contact is pushed off by the margins);
   // confirmed when the object's centre of mass moved less than `max_translation` and the object
   // turned less than `max_rotation_deg`, both measured against the goal pose.
@@ -143,7 +143,7 @@ struct VerifyStats {
   int threads = 1;
 };
 
-// Physics check in the product (issue 9): simulates the best `k` stable candidates of `result`
+// Physics check in the product: simulates the best `k` stable candidates of `result`
 // (candidates are ranked best first; unstable ones are skipped and do not count against k) with
 // check() above, released 2 mm above the pose: stayed = moved < 1 cm and turned < 5 deg. The
 // object gets the plan's friction mu, gravity is 9.81 m/s^2 along cfg.gravity; everything else

@@ -1,4 +1,4 @@
-// The benchmark suite (issue 5): per object/area pair, the planner and Bullet in one process —
+// The benchmark suite: per object/area pair, the planner and Bullet in one process —
 // planner times, candidates, physics-confirmed precision, coverage and the drop-and-settle
 // baseline over the same floor points.
 #pragma once

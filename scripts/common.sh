@@ -18,7 +18,7 @@ PP_PACKAGES=(
   librosbag-dev python3-rosbag rosout python3-rostopic python3-rosnode python3-rosmsg
   liburdfdom-dev liburdf-dev libopencv-dev libeigen3-dev libvisualization-msgs-dev
   python3-visualization-msgs libgeometry-msgs-dev python3-geometry-msgs libshape-msgs-dev
-  python3-shape-msgs
+  python3-shape-msgs python3-yaml
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libgtest-dev googletest rviz librviz-dev xvfb xauth imagemagick
   libbullet-dev libbullet-extras-dev libtbb-dev libbenchmark-dev

@@ -72,6 +72,9 @@ PlacePlannerNode::PlacePlannerNode(const ros::NodeHandle& nh, const ros::NodeHan
   candidates_pub_ = pnh_.advertise<geometry_msgs::PoseArray>("candidates", 1, true);
   feedback_timer_ = nh_.createWallTimer(ros::WallDuration(config_.feedback_period / 2),
                                         [this](const ros::WallTimerEvent&) { onFeedbackTimer(); });
+  tuned_planner_ = config_.planner;
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<PlacePlannerConfig>>(reconfigure_mutex_, pnh_);
+  reconfigure_->setCallback([this](PlacePlannerConfig& c, uint32_t level) { onReconfigure(c, level); });
   goal_thread_ = std::thread([this] { goalLoop(); });
   server_ = std::make_unique<Server>(
       pnh_, "place_plan", [this](GoalHandle g) { onGoal(g); }, [this](GoalHandle g) { onCancel(g); });
@@ -248,7 +251,14 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   topics.area_shape_topic = area_shape_sub_.getTopic();
   int objects = 0;
   Mesh added = areaAdditions(goal, placed_, &objects);
-  answer->prepared = prepareGoal(goal, topics, config_, [this](const std::string& f) { return lookup(f); }, &added);
+  // The planner parameters as tuned when this goal starts (dynamic_reconfigure).
+  NodeConfig goal_config = config_;
+  {
+    std::lock_guard<std::mutex> lock(tuning_mutex_);
+    goal_config.planner = tuned_planner_;
+  }
+  answer->prepared =
+      prepareGoal(goal, topics, goal_config, [this](const std::string& f) { return lookup(f); }, &added);
   // The goal is valid: its reset/add stands, whatever the plan comes to.
   placed_.added_W = std::move(added);
   placed_.count = objects;
@@ -374,6 +384,27 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   }
   ROS_INFO("place_planner: %s%s, %s", errorCodeName(result.error_code), result.partial ? " (partial)" : "",
            summary.str().c_str());
+}
+
+void PlacePlannerNode::onReconfigure(PlacePlannerConfig& tuning, uint32_t /*level*/) {
+  tuning.__toServer__(pnh_);
+  try {
+    NodeConfig fresh = loadNodeConfig(pnh_);
+    fresh.planner.gripper = config_.planner.gripper;  // startup-only (not in the .cfg)
+    {
+      std::lock_guard<std::mutex> lock(tuning_mutex_);
+      tuned_planner_ = fresh.planner;
+    }
+    if (tuned_once_) ROS_INFO("place_planner: planner parameters updated (dynamic_reconfigure): the next goal uses them");
+    last_tuning_ = tuning;
+    tuned_once_ = true;
+  } catch (const std::exception& e) {
+    ROS_ERROR("place_planner: dynamic_reconfigure refused: %s; the previous values are kept", e.what());
+    if (tuned_once_) {
+      last_tuning_.__toServer__(pnh_);
+      tuning = last_tuning_;
+    }
+  }
 }
 
 bool PlacePlannerNode::onProgress(const Progress& progress) {

@@ -4,6 +4,7 @@
 // broadcasts), O = the object's mesh frame.
 #include <actionlib/client/action_client.h>
 #include <actionlib/client/simple_action_client.h>
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/package.h>
 #include <ros/ros.h>
@@ -1278,6 +1279,60 @@ TEST(PlacePlannerParams, NodeRefusesToStartWithBadParameter) {
   EXPECT_TRUE(WIFEXITED(status2) && WEXITSTATUS(status2) == 1) << output;
   EXPECT_NE(output.find("/bad_gripper_planner/gripper_links"), std::string::npos) << output;
   EXPECT_NE(output.find("thumb"), std::string::npos) << output;
+}
+
+// Live tuning (config/PlacePlanner.cfg): a parameter set through dynamic_reconfigure is used by
+// the next goal; a combination validate() refuses is named in the log and the old value kept.
+dynamic_reconfigure::Config reconfigure(const dynamic_reconfigure::Config& change) {
+  dynamic_reconfigure::Reconfigure srv;
+  srv.request.config = change;
+  EXPECT_TRUE(ros::service::waitForService("/place_planner/set_parameters", ros::Duration(10.0)));
+  EXPECT_TRUE(ros::service::call("/place_planner/set_parameters", srv));
+  return srv.response.config;
+}
+
+dynamic_reconfigure::Config intChange(const std::string& name, int value) {
+  dynamic_reconfigure::Config c;
+  dynamic_reconfigure::IntParameter p;
+  p.name = name;
+  p.value = value;
+  c.ints.push_back(p);
+  return c;
+}
+
+TEST(PlacePlannerParams, DynamicReconfigureIsUsedByTheNextGoal) {
+  PlacePlanGoal goal = boxOnPlaneGoalForCuda();
+  goal.max_candidates = 0;  // no override: the node's parameter decides
+  reconfigure(intChange("max_candidates", 2));
+  int value = 0;
+  EXPECT_TRUE(ros::param::get("/place_planner/max_candidates", value));
+  EXPECT_EQ(value, 2);
+  const Answer two = send(goal);
+  EXPECT_EQ(two.result.error_code, Result::SUCCESS) << two.result.error_message;
+  EXPECT_EQ(two.result.candidates.size(), 2u);
+
+  // approach_min_distance above approach_distance (0.10 m): refused, the old value stays.
+  dynamic_reconfigure::Config bad;
+  dynamic_reconfigure::DoubleParameter d;
+  d.name = "approach_min_distance";
+  d.value = 0.5;
+  bad.doubles.push_back(d);
+  const dynamic_reconfigure::Config after = reconfigure(bad);
+  bool seen = false;
+  for (const auto& p : after.doubles)
+    if (p.name == "approach_min_distance") {
+      seen = true;
+      EXPECT_NEAR(p.value, 0.03, 1e-9) << "a refused value was kept";
+    }
+  EXPECT_TRUE(seen);
+  const Answer still_two = send(goal);
+  EXPECT_EQ(still_two.result.error_code, Result::SUCCESS) << still_two.result.error_message;
+  EXPECT_EQ(still_two.result.candidates.size(), 2u);
+
+  reconfigure(intChange("max_candidates", 10));
+  const Answer more = send(goal);
+  EXPECT_EQ(more.result.error_code, Result::SUCCESS) << more.result.error_message;
+  EXPECT_GT(more.result.candidates.size(), 2u);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include <dynamic_reconfigure/server.h>
 #include <pcl_msgs/PolygonMesh.h>
 #include <shape_msgs/Mesh.h>
 #include <ros/ros.h>
@@ -29,6 +30,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "place_planner/PlacePlanAction.h"
+#include "place_planner/PlacePlannerConfig.h"
 #include "place_planner/planner.h"
 #include "place_planner/ros/params.h"
 #include "place_planner/ros/place_plan_server.h"
@@ -66,12 +68,23 @@ class PlacePlannerNode {
   // Between goals: freed heap back to the OS, so that the resident size is what the node holds.
   static void releaseFreedMemory();
   bool onProgress(const Progress& progress);
+  // dynamic_reconfigure (config/PlacePlanner.cfg): the new values go to the parameter server and
+  // through loadNodeConfig (the startup reader and validate()); refused ones are logged by name
+  // and the previous values kept. The next goal plans with them; a running goal keeps its own.
+  void onReconfigure(PlacePlannerConfig& tuning, uint32_t level);
   void onFeedbackTimer();
   // Publishes when feedback_period has passed since the last feedback.
   void publishFeedback(const Progress& progress);
 
   ros::NodeHandle nh_, pnh_;
-  NodeConfig config_;
+  NodeConfig config_;  // as loaded at startup; never changed after (read by every thread)
+  // The planner parameters as tuned live; each goal copies them when it starts.
+  std::mutex tuning_mutex_;
+  PlannerConfig tuned_planner_;
+  PlacePlannerConfig last_tuning_;  // the last accepted values (callback thread only)
+  bool tuned_once_ = false;
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<PlacePlannerConfig>> reconfigure_;
   Planner planner_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;

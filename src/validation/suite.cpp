@@ -123,8 +123,55 @@ std::vector<ScenePair> defaultPairs(const std::string& data_dir) {
   return pairs;
 }
 
+std::vector<ScenePair> scanPairs(const std::string& data_dir, const std::vector<std::string>& areas) {
+  std::vector<ScenePair> pairs;
+  std::ifstream in(data_dir + "/scans/MANIFEST.tsv");
+  if (!in) return pairs;
+  struct Row {
+    std::string file, source, kind, mode;
+  };
+  std::vector<Row> rows;
+  std::string line;
+  std::getline(in, line);  // header: file source kind mode ...
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    Row r;
+    std::getline(ls, r.file, '\t');
+    std::getline(ls, r.source, '\t');
+    std::getline(ls, r.kind, '\t');
+    std::getline(ls, r.mode, '\t');
+    if (!r.file.empty()) rows.push_back(r);
+  }
+  auto stem = [](const std::string& path) {
+    const size_t a = path.rfind('/') == std::string::npos ? 0 : path.rfind('/') + 1;
+    return path.substr(a, path.rfind('.') - a);
+  };
+  for (const std::string& area : areas) {
+    const Row* area_scan = nullptr;
+    for (const Row& r : rows)
+      if (r.kind == "area" && stem(r.source) == area) area_scan = &r;
+    if (!area_scan) continue;
+    for (const Row& r : rows) {
+      if (r.kind != "object") continue;
+      ScenePair p;
+      p.name = stem(r.file) + "@" + stem(area_scan->file);
+      p.object = data_dir + "/" + r.source;
+      p.area = data_dir + "/" + area_scan->source;
+      p.object_plan = data_dir + "/scans/" + r.file;
+      p.area_plan = data_dir + "/scans/" + area_scan->file;
+      p.mode = r.mode;
+      pairs.push_back(p);
+    }
+  }
+  return pairs;
+}
+
 SceneResult runScene(const ScenePair& pair, const SuiteConfig& config) {
   try {
+    if (!pair.object_plan.empty() || !pair.area_plan.empty())
+      return runScene(pair, loadSceneMesh(pair.object), loadSceneMesh(pair.area),
+                      loadSceneMesh(pair.object_plan.empty() ? pair.object : pair.object_plan),
+                      loadSceneMesh(pair.area_plan.empty() ? pair.area : pair.area_plan), config);
     return runScene(pair, loadSceneMesh(pair.object), loadSceneMesh(pair.area), config);
   } catch (const std::exception& e) {
     SceneResult r;
@@ -136,15 +183,22 @@ SceneResult runScene(const ScenePair& pair, const SuiteConfig& config) {
 
 SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh& area,
                      const SuiteConfig& config) {
+  if (config.hole_fraction > 0) {
+    SceneResult r = runScene(pair, object_full, area, punchHoles(object_full, config.hole_fraction, config.hole_seed),
+                             area, config);
+    r.variant = "holes_" + std::to_string(static_cast<int>(std::lround(config.hole_fraction * 100)));
+    return r;
+  }
+  return runScene(pair, object_full, area, object_full, area, config);
+}
+
+SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh& area_true,
+                     const Mesh& object, const Mesh& area, const SuiteConfig& config) {
   SceneResult r;
   r.pair = pair;
   r.area_triangles = static_cast<int>(area.triangles.size());
+  if (!pair.mode.empty()) r.variant = "scan_" + pair.mode;
   try {
-    Mesh object = object_full;
-    if (config.hole_fraction > 0) {
-      object = punchHoles(object_full, config.hole_fraction, config.hole_seed);
-      r.variant = "holes_" + std::to_string(static_cast<int>(std::lround(config.hole_fraction * 100)));
-    }
     r.object_triangles = static_cast<int>(object.triangles.size());
 
     // Planner.
@@ -162,7 +216,7 @@ SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh&
     ValidatorConfig vc = config.validator;
     vc.friction = config.planner.friction;
     if (pc.gravity.norm() > 1e-9) vc.gravity = 9.81 * pc.gravity.normalized();
-    const PhysicsValidator validator(object_full, area, vc);
+    const PhysicsValidator validator(object_full, area_true, vc);
     const auto t0 = Clock::now();
     for (size_t k = 0; k < plan.candidates.size() && r.validated < config.max_validated; ++k) {
       const Candidate& c = plan.candidates[k];
@@ -187,7 +241,7 @@ SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh&
       const int i = static_cast<int>((static_cast<long>(j) * nfp) / ndrop);
       DropRecord d;
       d.floor_point = i;
-      d.X_WO_start = dropStart(plan, i, object_full, area, up);
+      d.X_WO_start = dropStart(plan, i, object_full, area_true, up);
       d.result = validator.drop(d.X_WO_start);
       r.drops_at_rest += d.result.at_rest ? 1 : 0;
       r.drops_fell += d.result.fell_off ? 1 : 0;

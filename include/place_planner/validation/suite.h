@@ -19,13 +19,22 @@ Mesh loadSceneMesh(const std::string& source);
 
 struct ScenePair {
   std::string name;    // e.g. "mug_ycb025_1k@table"
-  std::string object;  // mesh source
-  std::string area;    // mesh source
+  std::string object;  // mesh source: the true object, validated against
+  std::string area;    // mesh source: the true area, validated on
+  // Scans (../shared/data/scans): planned on these, validated on the true meshes above. Empty:
+  // planned on the true meshes.
+  std::string object_plan;
+  std::string area_plan;
+  std::string mode;    // the object scan's mode (all_around, upper, in_hand), "" for meshes
 };
 
 // The default list: the YCB objects x areas of ../shared/data (when data_dir is not empty and
 // exists) and the built-in objects x built-in areas.
 std::vector<ScenePair> defaultPairs(const std::string& data_dir);
+
+// The scan suite: every object scan of DATA/scans/MANIFEST.tsv on the robot-head scan of each
+// of `areas` (names of DATA/areas), planned on the scans and validated on the true meshes.
+std::vector<ScenePair> scanPairs(const std::string& data_dir, const std::vector<std::string>& areas);
 
 struct SuiteConfig {
   PlannerConfig planner;        // threads is set to 1 by default (Bullet is single-threaded)
@@ -74,6 +83,19 @@ struct SceneResult {
   std::string error;             // non-empty when the scene could not run (load/plan failed)
 
   double precision() const { return validated ? double(confirmed) / validated : 0.0; }
+  // The best stable pose (the first validated) was confirmed.
+  bool bestConfirmed() const { return !checks.empty() && checks.front().check.confirmed; }
+  // Confirmed among the first k validated (the top-k stable poses).
+  int confirmedOfTop(int k, int* validated_top) const {
+    int n = 0, c = 0;
+    for (const auto& ch : checks)
+      if (n < k) {
+        ++n;
+        c += ch.check.confirmed ? 1 : 0;
+      }
+    *validated_top = n;
+    return c;
+  }
   bool plannerConfirmed() const { return confirmed > 0; }
   bool bulletRests() const { return drops_at_rest > 0; }
   double speedup() const {  // Bullet ms per drop / planner ms per floor point
@@ -88,6 +110,9 @@ SceneResult runScene(const ScenePair& pair, const SuiteConfig& config);
 // Same, with meshes already loaded (object_full is validated against; planned on after holes).
 SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh& area,
                      const SuiteConfig& config);
+// Planned on object_plan / area_plan (scans), validated on object_true / area_true.
+SceneResult runScene(const ScenePair& pair, const Mesh& object_true, const Mesh& area_true,
+                     const Mesh& object_plan, const Mesh& area_plan, const SuiteConfig& config);
 
 struct SuiteSummary {
   int scenes = 0, errors = 0;

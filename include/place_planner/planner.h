@@ -70,6 +70,9 @@ struct Candidate {
   Robustness robustness;
   PhysicsCheck physics;
   StartKind start = StartKind::kPrincipalAxis;
+  // Its contacts need surface the scan never saw (a cap of an open region, model/completion.h):
+  // flagged, and ranked after the stable poses on seen surface.
+  bool completed_support = false;
   double reorientation = 0.0;      // rad, rotation from the held orientation to the goal
   std::vector<ContactPoint> contacts;                       // at the goal pose
   Eigen::Vector3d floor_point_W = Eigen::Vector3d::Zero();

@@ -15,6 +15,7 @@
 #include <optional>
 
 #include "place_planner/model/area_model_cache.h"
+#include "place_planner/model/completion.h"
 #include "place_planner/model/area_up.h"
 #include "place_planner/infra/backend.h"
 #include "place_planner/infra/cuda_backend.h"
@@ -305,9 +306,10 @@ struct SearchMonitor {
 // One plan's state shared by its steps: the inputs, the clock and the budget, the answer being
 // built, and the stop signal that a cancel or the budget sends to the setup steps.
 struct PlanRun {
-  PlanRun(const Mesh& o, const Mesh& a, const PlannerConfig& c, const ProgressCallback& p)
-      : object(o), area(a), config(c), progress(p) {}
+  PlanRun(const Completion& o, const Mesh& a, const PlannerConfig& c, const ProgressCallback& p)
+      : completion(o), object(o.mesh), area(a), config(c), progress(p) {}
   PlanRun(const PlanRun&) = delete;  // setup_going points at this one
+  const Completion& completion;  // the object with its open regions capped (completion.h)
   const Mesh& object;
   const Mesh& area;
   const PlannerConfig& config;
@@ -318,6 +320,7 @@ struct PlanRun {
   StopSignal stop;
   std::function<bool()> setup_going = [this] { return keepGoing(t0, budget, progress, Progress{}, result); };
   PlanStats& st() { return result.stats; }
+  bool run_completion() const { return completion.completed(); }
 };
 
 // The models (III, V-B) and what the steps need of them. Frames: W planning, G gravity -z.
@@ -454,6 +457,17 @@ class TreeSearch {
     for (const auto& [leaf, rb] : monitor_.checked)
       if (rb.share() >= config.robust_min_share - 1e-9) in.robust_leaves.push_back(leaf);
     in.cut = [this] { return run_.result.cancelled || run_.result.timed_out; };
+    if (run_.run_completion()) {
+      // A contact on a cap, away from the seen rim by more than the contact spheres' reach.
+      const double margin = std::max(0.003, 2.0 * m_.rad.r);
+      in.completed_support = [this, margin](size_t i) {
+        const TreeLeaf& l = leaves_[i];
+        const Eigen::Isometry3d X_OG = toIsometry(l.X_GO).inverse();
+        for (const ContactPoint& c : l.contacts)
+          if (onCompletedSurface(run_.completion, X_OG * c.p_W, margin)) return true;
+        return false;
+      };
+    }
     const PlaceabilityContext pc{m_.om, *m_.am, *m_.backend, m_.d_vis, config};
     run_.result.candidates = rankCandidates(
         in, config, [&](const std::vector<size_t>& idx) { return monitor_.robustnessOf(idx); }, &run_.st(),
@@ -495,7 +509,9 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   validate(config);
   if (object.empty()) throw std::invalid_argument("object mesh is empty");
   if (area.empty()) throw std::invalid_argument("placement area mesh is empty");
-  PlanRun run(object, area, config, progress);
+  // Unseen is not empty: open regions of a scanned object capped (model/completion.h).
+  const Completion completion = completeOpenRegions(object);
+  PlanRun run(completion, area, config, progress);
   // ---- models (III, V-B)
   const std::optional<Models> models = buildModels(run, *cache_);
   if (!models) return stopped(run.result, run.t0);

@@ -256,6 +256,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
         {"orientation_xyzw", quatJson(k.X_WO.linear())},
         {"quality", k.quality},
         {"stable", k.stable},
+        {"support", k.completed_support ? "completed" : "seen"},
         {"start", toString(k.start)},
         {"robustness",
          {{"trials", k.robustness.trials},

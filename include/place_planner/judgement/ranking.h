@@ -22,6 +22,9 @@ struct RankingInput {
   // True once a cancel or the budget has cut the plan: the robust leaves above stay robust even
   // where the ranking's own checks did not reach them.
   std::function<bool()> cut = {};
+  // True when a stable leaf rests on completed surface (model/completion.h): such poses rank
+  // after every stable pose on seen surface. Empty: the object was closed.
+  std::function<bool(size_t)> completed_support = {};
 };
 
 // Robustness of the leaves given by index (robustness.h); called on the best stable leaves

@@ -1,0 +1,44 @@
+// Unseen is not empty (beyond the paper, which names "complete unmodelled regions" as future
+// work). A scanned object is open where the camera never looked: the bottom of an object scanned
+// from above, the end hidden by the hand. The planner closes each open region (a loop of boundary
+// edges) with a cap, the polygon the loop spans (ear-clipped in its best-fit plane by buildMesh),
+// and remembers which surface is completed:
+//   - the model planned on is closed, so the object rests on the cap, never on the open rim with
+//     its unseen part below the area's surface, and the centre of mass (from the surface) moves
+//     toward the unseen side as it should;
+//   - a pose whose contacts lie on a cap (inside it, farther than `margin` from the seen rim) needs
+//     surface that was not seen: it is flagged (Candidate::support) and ranked after every stable
+//     pose on seen surface (ranking.h).
+// Frame: the object's own frame O throughout.
+#pragma once
+#include <Eigen/Core>
+#include <vector>
+
+#include "place_planner/model/mesh.h"
+
+namespace place_planner {
+
+struct CompletionCap {
+  std::vector<Eigen::Vector3d> loop;  // the open region's boundary, in order
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // best-fit plane, pointing out of the object
+  double flatness = 0;  // m, largest distance of a loop vertex from the plane
+};
+
+struct Completion {
+  Mesh mesh;                       // the object with every open region capped (or the input)
+  std::vector<CompletionCap> caps;  // empty: the mesh was closed
+  double open_perimeter = 0;       // m, summed over the loops
+  bool completed() const { return !caps.empty(); }
+};
+
+// Caps every loop of boundary edges of `object` (edges of one triangle). A triangle soup
+// (more than half the edges open: no shared vertices) is returned as it is.
+Completion completeOpenRegions(const Mesh& object);
+
+// True when the contact point p_O (on the object's surface, frame O) lies on a cap: within
+// `margin` of its plane (or of its flatness, whichever is larger), inside the loop's polygon
+// and farther than `margin` from the loop (the seen rim itself is seen).
+bool onCompletedSurface(const Completion& completion, const Eigen::Vector3d& p_O, double margin);
+
+}  // namespace place_planner

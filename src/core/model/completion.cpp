@@ -1,0 +1,105 @@
+// Caps of open regions (completion.h).
+#include "place_planner/model/completion.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace place_planner {
+namespace {
+
+// Distance from p to segment ab.
+double segmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double t = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+}  // namespace
+
+Completion completeOpenRegions(const Mesh& object) {
+  Completion c;
+  c.mesh = object;
+  // Directed edges of the triangles; an edge whose reverse is missing and which is used once
+  // borders an open region. Non-manifold edges (used three times or more) are left alone.
+  std::map<std::pair<int, int>, int> directed, undirected;
+  for (const auto& t : object.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a == b) continue;
+      ++directed[{a, b}];
+      ++undirected[{std::min(a, b), std::max(a, b)}];
+    }
+  std::multimap<int, int> next;  // boundary half-edge a -> b, walked a -> b -> ...
+  size_t open = 0;
+  for (const auto& [e, n] : directed) {
+    if (n != 1 || undirected[{std::min(e.first, e.second), std::max(e.first, e.second)}] != 1) continue;
+    next.emplace(e.first, e.second);
+    ++open;
+  }
+  if (open == 0 || open * 2 > undirected.size()) return c;  // closed, or a soup
+  std::vector<std::vector<int>> polygons = object.patches;
+  while (!next.empty()) {
+    auto it = next.begin();
+    std::vector<int> loop{it->first};
+    int at = it->second;
+    next.erase(it);
+    for (size_t guard = 0; at != loop.front() && guard < open; ++guard) {
+      loop.push_back(at);
+      auto nx = next.find(at);
+      if (nx == next.end()) break;
+      at = nx->second;
+      next.erase(nx);
+    }
+    if (at != loop.front() || loop.size() < 3) continue;  // an open chain (pinched): not a loop
+    CompletionCap cap;
+    for (int v : loop) cap.loop.push_back(object.vertices[static_cast<size_t>(v)]);
+    for (const auto& p : cap.loop) cap.centroid += p;
+    cap.centroid /= static_cast<double>(cap.loop.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& p : cap.loop) cov += (p - cap.centroid) * (p - cap.centroid).transpose();
+    Eigen::Vector3d n = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+    // Out of the object: away from the object's centre (of the seen surface).
+    if (n.dot(cap.centroid - object.properties.center_of_mass) < 0) n = -n;
+    cap.normal = n;
+    for (const auto& p : cap.loop) cap.flatness = std::max(cap.flatness, std::abs((p - cap.centroid).dot(n)));
+    for (size_t i = 0; i < cap.loop.size(); ++i)
+      c.open_perimeter += (cap.loop[(i + 1) % cap.loop.size()] - cap.loop[i]).norm();
+    // The boundary half-edges run a -> b inside their triangles; the cap runs the other way.
+    std::reverse(loop.begin(), loop.end());
+    polygons.push_back(loop);
+    c.caps.push_back(std::move(cap));
+  }
+  if (c.caps.empty()) return c;
+  try {
+    c.mesh = buildMesh(object.vertices, polygons, "completed object mesh");
+  } catch (const std::exception&) {
+    c.mesh = object;  // a cap that cannot be built: plan on the scan as it is
+    c.caps.clear();
+  }
+  return c;
+}
+
+bool onCompletedSurface(const Completion& completion, const Eigen::Vector3d& p, double margin) {
+  for (const CompletionCap& cap : completion.caps) {
+    const double off = (p - cap.centroid).dot(cap.normal);
+    if (std::abs(off) > std::max(margin, cap.flatness + margin)) continue;
+    // Inside the loop: the loop's winding number about p, in the cap's plane.
+    const Eigen::Vector3d u = cap.normal.unitOrthogonal(), w = cap.normal.cross(u);
+    double angle = 0, rim = 1e300;
+    const size_t n = cap.loop.size();
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d& a = cap.loop[i];
+      const Eigen::Vector3d& b = cap.loop[(i + 1) % n];
+      rim = std::min(rim, segmentDistance(p, a, b));
+      const Eigen::Vector2d a2((a - p).dot(u), (a - p).dot(w)), b2((b - p).dot(u), (b - p).dot(w));
+      angle += std::atan2(a2.x() * b2.y() - a2.y() * b2.x(), a2.dot(b2));
+    }
+    if (std::abs(angle) > M_PI && rim > margin) return true;
+  }
+  return false;
+}
+
+}  // namespace place_planner

@@ -46,6 +46,10 @@ if(CATKIN_ENABLE_TESTING)
   # The soak (scripts/soak, python): the short form, 60 goals of every kind.
   add_rostest(test/ros/soak.test DEPENDENCIES place_planner_node)
 
+  # One result message per goal id (raw goals and cancels, a node killed mid-goal), and clients
+  # that cancel only what the server has acknowledged (test_one_result_per_goal.py).
+  add_rostest(test/ros/one_result_per_goal.test DEPENDENCIES place_planner_node)
+
   # launch/place_planner.launch respawns a killed node (test_respawn.py).
   add_rostest(test/ros/respawn.test DEPENDENCIES place_planner_node)
 

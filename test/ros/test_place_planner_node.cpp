@@ -463,6 +463,11 @@ TEST(PlacePlannerNode, SupersededOrCancelledWaitingGoalIsPreemptedNeverSuccess) 
   while (a.getCommState() != actionlib::CommState::ACTIVE) ros::WallDuration(0.002).sleep();
   // B preempts A; cancelling B at once catches it waiting (or just started: then PREEMPTED).
   MultiClient::GoalHandle b = ac.sendGoal(longGoal());
+  // actionlib's rule: cancel what the server has acknowledged (a cancel sent before that can
+  // meet a status list without the goal, which the client takes as LOST).
+  const ros::WallTime ack_by = ros::WallTime::now() + ros::WallDuration(5.0);
+  while (b.getCommState() == actionlib::CommState::WAITING_FOR_GOAL_ACK && ros::WallTime::now() < ack_by)
+    ros::WallDuration(0.001).sleep();
   b.cancel();
   ASSERT_TRUE(waitDone(a, 5.0));
   ASSERT_TRUE(waitDone(b, 5.0));

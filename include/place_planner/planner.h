@@ -38,6 +38,10 @@ struct PhysicsCheck {
   double turned_deg = 0.0;
 };
 
+// What carries a candidate: seen surface, or surface a scan never saw (model/completion.h).
+enum class SupportKind { kSeen, kCompleted, kAreaBorder };
+const char* toString(SupportKind s);  // "seen", "completed", "area_border"
+
 // Which start orientation a candidate's tree began from (Section IV-A, generalised).
 enum class StartKind { kRestingFace, kHeld, kPrincipalAxis, kAreaTurn, kAxis };
 const char* toString(StartKind k);
@@ -70,9 +74,11 @@ struct Candidate {
   Robustness robustness;
   PhysicsCheck physics;
   StartKind start = StartKind::kPrincipalAxis;
-  // Its contacts need surface the scan never saw (a cap of an open region, model/completion.h):
-  // flagged, and ranked after the stable poses on seen surface.
-  bool completed_support = false;
+  // What carries it (model/completion.h): kSeen, or surface the scans never saw: kCompleted (a
+  // contact on a cap over an open region of the object) or kAreaBorder (a contact at the border
+  // of what the area's scan saw). Those rank after every stable pose on seen surface.
+  SupportKind support = SupportKind::kSeen;
+  bool completed_support() const { return support != SupportKind::kSeen; }
   double reorientation = 0.0;      // rad, rotation from the held orientation to the goal
   std::vector<ContactPoint> contacts;                       // at the goal pose
   Eigen::Vector3d floor_point_W = Eigen::Vector3d::Zero();

@@ -97,6 +97,8 @@ void validate(const PlannerConfig& c) {
   requireVector(c.prefer_near, "prefer_near", true);
   require(c.grasp.matrix().allFinite() && std::abs(c.grasp.linear().determinant() - 1.0) < 1e-3, "grasp",
           c.grasp.linear().determinant(), "a rigid transform (rotation determinant 1)");
+  require(std::isfinite(c.scan_noise) && c.scan_noise >= 0 && c.scan_noise <= 0.05, "scan_noise", c.scan_noise,
+          "0 .. 0.05 m");
   require(std::isfinite(c.merge_angle_deg) && c.merge_angle_deg >= 0, "merge_angle_deg",
           c.merge_angle_deg, ">= 0");
 }

@@ -14,6 +14,15 @@ const char* toString(StartKind k) {
   return "?";
 }
 
+const char* toString(SupportKind s) {
+  switch (s) {
+    case SupportKind::kSeen: return "seen";
+    case SupportKind::kCompleted: return "completed";
+    case SupportKind::kAreaBorder: return "area_border";
+  }
+  return "?";
+}
+
 const char* toString(PlanOutcome o) {
   switch (o) {
     case PlanOutcome::kStable: return "stable";

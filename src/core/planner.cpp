@@ -457,15 +457,23 @@ class TreeSearch {
     for (const auto& [leaf, rb] : monitor_.checked)
       if (rb.share() >= config.robust_min_share - 1e-9) in.robust_leaves.push_back(leaf);
     in.cut = [this] { return run_.result.cancelled || run_.result.timed_out; };
-    if (run_.run_completion()) {
-      // A contact on a cap, away from the seen rim by more than the contact spheres' reach.
+    if (run_.run_completion() || !m_.am->open_edges.empty()) {
+      // A contact on a cap of the object, away from the seen rim by more than the contact
+      // spheres' reach, or at the border of what the area's scan saw (completion.h).
       const double margin = std::max(0.003, 2.0 * m_.rad.r);
       in.completed_support = [this, margin](size_t i) {
         const TreeLeaf& l = leaves_[i];
         const Eigen::Isometry3d X_OG = toIsometry(l.X_GO).inverse();
-        for (const ContactPoint& c : l.contacts)
-          if (onCompletedSurface(run_.completion, X_OG * c.p_W, margin)) return true;
-        return false;
+        for (const ContactPoint& c : l.contacts) {
+          if (run_.run_completion() && onCompletedSurface(run_.completion, X_OG * c.p_W, margin))
+            return SupportKind::kCompleted;
+          for (const auto& e : m_.am->open_edges) {
+            const Eigen::Vector3d ab = e[1] - e[0];
+            const double t = std::clamp((c.p_W - e[0]).dot(ab) / std::max(ab.squaredNorm(), 1e-18), 0.0, 1.0);
+            if ((e[0] + t * ab - c.p_W).norm() < margin) return SupportKind::kAreaBorder;
+          }
+        }
+        return SupportKind::kSeen;
       };
     }
     const PlaceabilityContext pc{m_.om, *m_.am, *m_.backend, m_.d_vis, config};
@@ -522,6 +530,17 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   TreeSearch search(run, *models, *roots);
   search.run();
   search.rank(*roots);
+  // A scanned object's unseen part may reach below its cap: released scan_noise higher
+  // (config.h), with its path and pre-place pose.
+  if (completion.completed() && config.scan_noise > 0) {
+    const Eigen::Vector3d lift = -config.scan_noise * config.gravity.normalized();
+    for (Candidate& c : run.result.candidates) {
+      c.X_WO.pretranslate(lift);
+      for (Eigen::Isometry3d& X : c.intermediate_poses) X.pretranslate(lift);
+      c.placement.pre_place_W.pretranslate(lift);
+      if (c.has_gripper_pose) c.X_WF = c.X_WO * config.grasp;
+    }
+  }
   // The first robust stable pose was found by the ranking (the search's checks were bounded).
   if (run.st().first_stable_ms < 0 && run.result.stableCount() > 0) run.st().first_stable_ms = msSince(run.t0);
   if (run.budget > 0 && msSince(run.t0) > run.budget) run.result.timed_out = true;

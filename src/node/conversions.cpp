@@ -207,7 +207,7 @@ void toMsg(const Candidate& c, const std::string& frame_id, const std::string& g
   msg->blocked = pl.blocked;
   msg->quality = c.quality;
   msg->stable = c.stable;
-  msg->support = c.completed_support ? "completed" : "seen";
+  msg->support = toString(c.support);
   msg->robust_share = c.robustness.share();
   msg->robust_trials = c.robustness.trials;
   msg->min_tipping_angle = c.robustness.min_tipping_angle;

@@ -287,6 +287,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("rank_order", &rank_order);
   r.read("prefer_near", &p.prefer_near);
   r.read("min_edge_clearance", &p.min_edge_clearance);
+  r.read("scan_noise", &p.scan_noise);
   try {
     p.rank_order = rankOrderFromName(rank_order);
     p.orientation = orientationModeFromString(orientation);

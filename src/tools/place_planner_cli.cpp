@@ -135,6 +135,7 @@ const std::map<std::string, std::string> kFlagOfField = {
     {"retreat_distance", "--retreat-distance"},
     {"retreat_min_distance", "--retreat-min-distance"},
     {"min_edge_clearance", "--min-edge-clearance"},
+    {"scan_noise", "--scan-noise"},
     {"prefer_near", "--prefer-near"},
     {"grasp", "--grasp"},
 };
@@ -256,7 +257,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
         {"orientation_xyzw", quatJson(k.X_WO.linear())},
         {"quality", k.quality},
         {"stable", k.stable},
-        {"support", k.completed_support ? "completed" : "seen"},
+        {"support", toString(k.support)},
         {"start", toString(k.start)},
         {"robustness",
          {{"trials", k.robustness.trials},
@@ -529,6 +530,10 @@ int main(int argc, char** argv) {
          "--prefer-near", [&](const std::string& s) { c.prefer_near = parseVector("--prefer-near", s); },
          "point for --rank-order nearest (planning frame)")
       ->type_name("x,y,z");
+  app.add_option("--scan-noise", c.scan_noise,
+                 "[m] uncertainty of a scanned surface: an open (scanned) object is released this much higher")
+      ->check(kFinite)
+      ->capture_default_str();
   app.add_option("--min-edge-clearance", c.min_edge_clearance, "[m] from a drop-off of the area, 0 = off")
       ->check(kFinite)
       ->capture_default_str();

@@ -24,7 +24,7 @@ struct RankingInput {
   std::function<bool()> cut = {};
   // True when a stable leaf rests on completed surface (model/completion.h): such poses rank
   // after every stable pose on seen surface. Empty: the object was closed.
-  std::function<bool(size_t)> completed_support = {};
+  std::function<SupportKind(size_t)> completed_support = {};
 };
 
 // Robustness of the leaves given by index (robustness.h); called on the best stable leaves

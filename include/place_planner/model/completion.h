@@ -12,6 +12,7 @@
 // Frame: the object's own frame O throughout.
 #pragma once
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "place_planner/model/mesh.h"
@@ -31,6 +32,10 @@ struct Completion {
   double open_perimeter = 0;       // m, summed over the loops
   bool completed() const { return !caps.empty(); }
 };
+
+// Edges of exactly one triangle (vertex indices): the borders of what a scan saw. Empty for a
+// closed mesh and for a triangle soup (more than half the edges open: no shared vertices).
+std::vector<std::array<int, 2>> openEdges(const Mesh& mesh);
 
 // Caps every loop of boundary edges of `object` (edges of one triangle). A triangle soup
 // (more than half the edges open: no shared vertices) is returned as it is.

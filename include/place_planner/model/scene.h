@@ -60,6 +60,9 @@ struct AreaModel : MeshModel {  // frame G
   size_t source_triangles = 0;   // of the mesh given; more than triangles.size() when decimated
   uint64_t id = 0;               // unique per build: the key of the CUDA backend's device copy
   double decimation_cell = 0.0;  // m, cluster size of the decimation (0: none)
+  // Borders of what the area's scan saw (edges of one triangle, completion.h), frame G: beyond
+  // them the area is unknown, so a pose leaning there needs surface that was not seen.
+  std::vector<std::array<Eigen::Vector3d, 2>> open_edges;
 };
 
 // Edges for the edge/edge tests: all but those between two (nearly) coplanar triangles. A

@@ -19,7 +19,7 @@ struct Item {
   bool checked = false;
   long preference = 0;  // config.rank_order's key, lower first
   Placement placement;
-  bool completed = false;  // rests on completed (unseen) surface: after the seen ones
+  SupportKind support = SupportKind::kSeen;  // on unseen surface: after the seen ones
   double score() const {
     const double share = checked ? robustness.share() : 1.0;
     return quality - 0.05 * reorientation / M_PI - 0.05 * (1.0 - share);
@@ -35,7 +35,8 @@ void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
   stableSortAligned(items, [&](const Item& a, const Item& b) {
     if (a.stable != b.stable) return a.stable;
     // Unseen is not empty: a pose on seen surface first, where one exists (completion.h).
-    if (a.stable && a.completed != b.completed) return !a.completed;
+    const bool ua = a.support != SupportKind::kSeen, ub = b.support != SupportKind::kSeen;
+    if (a.stable && ua != ub) return !ua;
     if (a.preference != b.preference) return a.preference < b.preference;
     const long sa = quantised(a.score(), 1e-3), sb = quantised(b.score(), 1e-3);
     if (sa != sb) return sa > sb;
@@ -67,7 +68,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
       continue;
     }
     Item it{i, l.stable, l.quality, rotationAngle(in.R_held_G, X.linear()), {}, false, 0, {}};
-    if (l.stable && in.completed_support) it.completed = in.completed_support(i);
+    if (l.stable && in.completed_support) it.support = in.completed_support(i);
     if (config.rank_order == RankOrder::kLowest) it.preference = quantised((X * in.com_O).z(), 0.005);
     if (config.rank_order == RankOrder::kNearest) it.preference = quantised((X * in.com_O - near_G).norm(), 0.005);
     items.push_back(it);
@@ -189,7 +190,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     c.X_WO.translation() = R_WG * X_GO.translation();
     c.quality = l.quality;
     c.stable = it.stable;
-    c.completed_support = it.completed;
+    c.support = it.support;
     c.robustness = it.robustness;
     c.start = in.root_kind[l.root];
     c.reorientation = it.reorientation;

@@ -19,6 +19,29 @@ double segmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const
 
 }  // namespace
 
+std::vector<std::array<int, 2>> openEdges(const Mesh& mesh) {
+  // Undirected edges sorted: an edge seen once borders an open region.
+  std::vector<std::array<int, 2>> all;
+  all.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a != b) all.push_back({std::min(a, b), std::max(a, b)});
+    }
+  std::sort(all.begin(), all.end());
+  std::vector<std::array<int, 2>> open;
+  size_t unique = 0;
+  for (size_t i = 0; i < all.size();) {
+    size_t j = i;
+    while (j < all.size() && all[j] == all[i]) ++j;
+    ++unique;
+    if (j - i == 1) open.push_back(all[i]);
+    i = j;
+  }
+  if (open.size() * 2 > unique) open.clear();  // a soup: nothing is known to be open
+  return open;
+}
+
 Completion completeOpenRegions(const Mesh& object) {
   Completion c;
   c.mesh = object;

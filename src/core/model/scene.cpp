@@ -1,3 +1,4 @@
+#include "place_planner/model/completion.h"
 #include "place_planner/model/scene.h"
 
 #include <Eigen/Geometry>
@@ -210,6 +211,9 @@ AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, d
   static std::atomic<uint64_t> next_id{1};
   a.id = next_id++;
   a.up_facing_share = upFacingShare(area_W, -gravity_W);
+  for (const auto& e : openEdges(area_W))
+    a.open_edges.push_back({a.R_GW * area_W.vertices[static_cast<size_t>(e[0])],
+                            a.R_GW * area_W.vertices[static_cast<size_t>(e[1])]});
   return a;
 }
 

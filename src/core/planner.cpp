@@ -459,14 +459,18 @@ class TreeSearch {
     in.cut = [this] { return run_.result.cancelled || run_.result.timed_out; };
     if (run_.run_completion() || !m_.am->open_edges.empty()) {
       // A contact on a cap of the object, away from the seen rim by more than the contact
-      // spheres' reach, or at the border of what the area's scan saw (completion.h).
+      // spheres' reach, or a contact the object leans on (its normal outside the friction cone
+      // about the vertical: a wall, a peg's side) at the border of what the area's scan saw
+      // (completion.h). Resting on a top face near its edge is not leaning on the unseen side.
       const double margin = std::max(0.003, 2.0 * m_.rad.r);
-      in.completed_support = [this, margin](size_t i) {
+      const double floor_cos = std::cos(std::atan(run_.config.friction));
+      in.completed_support = [this, margin, floor_cos](size_t i) {
         const TreeLeaf& l = leaves_[i];
         const Eigen::Isometry3d X_OG = toIsometry(l.X_GO).inverse();
         for (const ContactPoint& c : l.contacts) {
           if (run_.run_completion() && onCompletedSurface(run_.completion, X_OG * c.p_W, margin))
             return SupportKind::kCompleted;
+          if (c.n_W.z() >= floor_cos) continue;  // G: z against gravity
           for (const auto& e : m_.am->open_edges) {
             const Eigen::Vector3d ab = e[1] - e[0];
             const double t = std::clamp((c.p_W - e[0]).dot(ab) / std::max(ab.squaredNorm(), 1e-18), 0.0, 1.0);
@@ -530,11 +534,12 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   TreeSearch search(run, *models, *roots);
   search.run();
   search.rank(*roots);
-  // A scanned object's unseen part may reach below its cap: released scan_noise higher
-  // (config.h), with its path and pre-place pose.
+  // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
+  // released scan_noise higher (config.h), with its path and pre-place pose.
   if (completion.completed() && config.scan_noise > 0) {
     const Eigen::Vector3d lift = -config.scan_noise * config.gravity.normalized();
     for (Candidate& c : run.result.candidates) {
+      if (c.support != SupportKind::kCompleted) continue;
       c.X_WO.pretranslate(lift);
       for (Eigen::Isometry3d& X : c.intermediate_poses) X.pretranslate(lift);
       c.placement.pre_place_W.pretranslate(lift);

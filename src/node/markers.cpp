@@ -125,7 +125,9 @@ visualization_msgs::MarkerArray buildMarkers(const Mesh& object_O, const Mesh& a
       text.scale.z = 0.03;  // text height
       setColour(&text, 1.0f, 1.0f, 1.0f, 1.0f);
       char buf[64];
-      std::snprintf(buf, sizeof buf, "#%d Q=%.2f%s", i + 1, c.quality, c.stable ? "" : " (unstable)");
+      std::snprintf(buf, sizeof buf, "#%d Q=%.2f%s%s", i + 1, c.quality, c.stable ? "" : " (unstable)",
+                    c.support == SupportKind::kSeen ? "" : c.support == SupportKind::kCompleted ? " (on unseen: completed)"
+                                                                                                 : " (on unseen: area border)");
       text.text = buf;
       array.markers.push_back(text);
     }
@@ -168,6 +170,12 @@ visualization_msgs::MarkerArray buildMarkers(const Mesh& object_O, const Mesh& a
       geometry_msgs::Point p;
       toMsg(contact.p_W, &p);
       contacts.points.push_back(p);
+      // Contacts of a pose on surface no scan saw (completion.h): magenta, the others red.
+      std_msgs::ColorRGBA colour;
+      colour.r = 1.0f;
+      colour.b = c.support == SupportKind::kSeen ? 0.0f : 1.0f;
+      colour.a = 1.0f;
+      contacts.colors.push_back(colour);
       if (k % stride != 0) continue;
       Marker arrow = makeMarker(o, marker_ns::kContactNormals, normal_id++, Marker::ARROW);
       arrow.scale.x = 0.003;  // shaft diameter

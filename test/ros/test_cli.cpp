@@ -471,6 +471,21 @@ TEST(PlacePlannerCli, CpuBackendIsNamedOnceAndNotAWarning) {
   EXPECT_TRUE(contains(v.err, "no usable GPU")) << v.err;
 }
 
+// Progress on standard error while a plan runs longer than a second, only when it is a terminal
+// (under script(1) here); piped, standard error stays clean.
+TEST(PlacePlannerCli, ProgressOnATerminalOnlyForLongPlans) {
+  if (access("/usr/bin/script", X_OK) != 0) GTEST_SKIP() << "script(1) (bsdutils) is not installed: no pseudo-terminal";
+  const std::vector<std::string> slow = {"--object", "builtin:mug", "--area", "builtin:table", "--spacing", "0.01",
+                                         "--threads", "1", "--no-robust-check"};
+  const CliRun tty = cli(slow, "exec script -qec \"$(printf '%q ' \"$@\")\" /dev/null");
+  EXPECT_EQ(tty.code, 0) << tty.out;
+  EXPECT_TRUE(contains(tty.out, "planning: floor points")) << tty.out.substr(0, 400);
+  EXPECT_TRUE(contains(tty.out, "stable so far")) << tty.out.substr(0, 400);
+  const CliRun piped = cli(slow);
+  EXPECT_EQ(piped.code, 0) << piped.err;
+  EXPECT_FALSE(contains(piped.err, "planning:")) << piped.err;
+}
+
 // Paths are bytes: quotes, backslashes and control characters are escaped; bytes that are not
 // UTF-8 become U+FFFD. The file always parses.
 TEST(PlacePlannerCli, JsonEscapesOddStrings) {

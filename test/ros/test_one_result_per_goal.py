@@ -31,7 +31,6 @@ import logging
 import math
 import os
 import signal
-import struct
 import sys
 import threading
 import time
@@ -43,12 +42,11 @@ import rosgraph
 import rospy
 import rostest
 from actionlib_msgs.msg import GoalID, GoalStatus, GoalStatusArray
-from pcl_msgs.msg import PolygonMesh, Vertices
 from rosgraph_msgs.msg import Log
-from sensor_msgs.msg import PointCloud2, PointField
 
 from place_planner.msg import (PlacePlanAction, PlacePlanActionGoal, PlacePlanActionResult,
                                PlacePlanGoal, PlacePlanResult)
+from mesh_messages import mesh_msg  # noqa: E402  (test/ros/mesh_messages.py)
 
 R = PlacePlanResult
 S = GoalStatus
@@ -64,20 +62,6 @@ STATUS_NAMES = {v: k for k, v in vars(GoalStatus).items() if k.isupper() and isi
 CODE_NAMES = {v: k for k, v in vars(PlacePlanResult).items() if k.isupper() and isinstance(v, int)}
 
 
-def mesh_msg(vertices, polygons, frame):
-    cloud = PointCloud2()
-    cloud.header.frame_id = frame
-    cloud.height, cloud.width = 1, len(vertices)
-    cloud.fields = [PointField(name=n, offset=4 * i, datatype=PointField.FLOAT32, count=1)
-                    for i, n in enumerate("xyz")]
-    cloud.point_step, cloud.row_step = 12, 12 * len(vertices)
-    cloud.data = b"".join(struct.pack("<3f", *v) for v in vertices)
-    cloud.is_dense = True
-    msg = PolygonMesh()
-    msg.header.frame_id = frame
-    msg.cloud = cloud
-    msg.polygons = [Vertices(vertices=list(p)) for p in polygons]
-    return msg
 
 
 def box(sx, sy, sz):

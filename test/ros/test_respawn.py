@@ -5,7 +5,6 @@ with required="true" roslaunch would have taken this test down with the node."""
 import math
 import os
 import signal
-import struct
 import sys
 import time
 import unittest
@@ -15,29 +14,15 @@ import actionlib
 import rosgraph
 import rospy
 import rostest
-from pcl_msgs.msg import PolygonMesh, Vertices
-from sensor_msgs.msg import PointCloud2, PointField
 
 from place_planner.msg import PlacePlanAction, PlacePlanGoal, PlacePlanResult
+from mesh_messages import mesh_msg  # noqa: E402  (test/ros/mesh_messages.py)
 
 NODE = "/place_planner"
 # respawn_delay in respawn.test is 0.5 s; the rest is process start and registration.
 COME_BACK = 15.0
 
 
-def mesh_msg(vertices, polygons, frame):
-    cloud = PointCloud2()
-    cloud.header.frame_id = frame
-    cloud.height, cloud.width = 1, len(vertices)
-    cloud.fields = [PointField(name=n, offset=4 * i, datatype=PointField.FLOAT32, count=1)
-                    for i, n in enumerate("xyz")]
-    cloud.point_step, cloud.row_step = 12, 12 * len(vertices)
-    cloud.data = b"".join(struct.pack("<3f", *v) for v in vertices)
-    msg = PolygonMesh()
-    msg.header.frame_id = frame
-    msg.cloud = cloud
-    msg.polygons = [Vertices(vertices=list(p)) for p in polygons]
-    return msg
 
 
 def goal():

@@ -475,8 +475,9 @@ TEST(PlacePlannerCli, CpuBackendIsNamedOnceAndNotAWarning) {
 // (under script(1) here); piped, standard error stays clean.
 TEST(PlacePlannerCli, ProgressOnATerminalOnlyForLongPlans) {
   if (access("/usr/bin/script", X_OK) != 0) GTEST_SKIP() << "script(1) (bsdutils) is not installed: no pseudo-terminal";
+  // About 3 s on one thread: the default search over 5000 floor points.
   const std::vector<std::string> slow = {"--object", "builtin:mug", "--area", "builtin:table", "--spacing", "0.01",
-                                         "--threads", "1", "--no-robust-check"};
+                                         "--threads", "1", "--orientation", "auto"};
   const CliRun tty = cli(slow, "exec script -qec \"$(printf '%q ' \"$@\")\" /dev/null");
   EXPECT_EQ(tty.code, 0) << tty.out;
   EXPECT_TRUE(contains(tty.out, "planning: floor points")) << tty.out.substr(0, 400);

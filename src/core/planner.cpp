@@ -126,8 +126,10 @@ TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaMod
   return ctx;
 }
 
-RobustnessParams robustnessParams(const PlannerConfig& config) {
+RobustnessParams robustnessParams(const PlannerConfig& config, bool scanned) {
   RobustnessParams rp;
+  // Shape noise of a scan (config.h scan_noise) through the centre-of-mass trials.
+  rp.min_com_offset = scanned ? config.scan_noise : 0.0;
   rp.shift = config.robust_shift;
   rp.tilt = config.robust_tilt_deg * M_PI / 180.0;
   rp.com_offset = config.robust_com_offset;
@@ -423,7 +425,7 @@ class TreeSearch {
         m_(m),
         roots_(r.floor_G, r.orientations, m.searched(run.object).properties, *m.am, m.d_vis),
         ctx_(treeContext(m.searched(run.object), m.om, *m.am, *m.backend, m.rad, run.config, run.st())),
-        rp_(robustnessParams(run.config)),
+        rp_(robustnessParams(run.config, run.run_completion())),
         // With the robustness check on, the search leaves a share of the budget for it.
         monitor_{m.om, *m.am, run.config, run.progress, run.t0,
                  run.budget * (run.config.robust_check ? kSearchShareOfBudget : 1.0), m.rad.r,

@@ -15,6 +15,10 @@ struct RobustnessParams {
   double tilt = 3.0 * M_PI / 180;  // rad, release tilt epsilon about 2 horizontal axes (4)
   double com_offset = 0.05;        // centre of mass moved horizontally (4 directions) by this
                                    // share of the object's extent along the direction
+  // ... and by at least this much (m): a scan's shape noise. A support surface displaced by d
+  // moves the support polygon's edge by d, which for tipping is the centre of mass moved by d
+  // against it; the planner sets it to scan_noise for a scanned (open) object.
+  double min_com_offset = 0.0;
   double lift = 0.002;             // m, released this far above the pose
   double end_distance = 0.01;      // m, a trial holds when it ends this close ...
   // ... and this little turned, stable. Below the release tilt: a tilted release must come

@@ -49,7 +49,7 @@ Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const Eigen::Vecto
     // The centre of mass off horizontally (G) by com_offset times the object's extent along
     // that direction (a slender object's error is slender too), expressed in O.
     const double along = d.x() != 0 ? extent.x() : extent.y();
-    t.com_O = om.com + rotateInv(X, toV3(p.com_offset * along * d));
+    t.com_O = om.com + rotateInv(X, toV3(std::max(p.com_offset * along, p.min_com_offset) * d));
   }
   t.X_start.t = t.X_start.t + v3(0, 0, lift);
   return t;

@@ -309,7 +309,7 @@ struct SearchMonitor {
 // built, and the stop signal that a cancel or the budget sends to the setup steps.
 struct PlanRun {
   PlanRun(const Completion& o, const Mesh& a, const PlannerConfig& c, const ProgressCallback& p)
-      : completion(o), object(o.mesh), area(a), config(c), progress(p) {}
+      : completion(o), object(o.mesh()), area(a), config(c), progress(p) {}
   PlanRun(const PlanRun&) = delete;  // setup_going points at this one
   const Completion& completion;  // the object with its open regions capped (completion.h)
   const Mesh& object;
@@ -472,12 +472,8 @@ class TreeSearch {
         for (const ContactPoint& c : l.contacts) {
           if (run_.run_completion() && onCompletedSurface(run_.completion, X_OG * c.p_W, margin))
             return SupportKind::kCompleted;
-          if (c.n_W.z() >= floor_cos) continue;  // G: z against gravity
-          for (const auto& e : m_.am->open_edges) {
-            const Eigen::Vector3d ab = e[1] - e[0];
-            const double t = std::clamp((c.p_W - e[0]).dot(ab) / std::max(ab.squaredNorm(), 1e-18), 0.0, 1.0);
-            if ((e[0] + t * ab - c.p_W).norm() < margin) return SupportKind::kAreaBorder;
-          }
+          if (c.n_W.z() < floor_cos && nearOpenEdge(m_.am->open_edges, c.p_W, margin))  // G: z up
+            return SupportKind::kAreaBorder;
         }
         return SupportKind::kSeen;
       };

@@ -361,16 +361,8 @@ void printOutcome(const PlannerConfig& c, const PlanResult& r) {
 // The JSON answer by the output-file rules, or to `json_fd` (standard output) for "-".
 // Throws OutputError (exit 4).
 void writeJson(const std::string& path, int json_fd, const std::string& text) {
-  if (json_fd >= 0) {
-    for (size_t done = 0; done < text.size();) {
-      const ssize_t n = ::write(json_fd, text.data() + done, text.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) throw OutputError(std::string("cannot write the JSON to standard output: ") + std::strerror(n < 0 ? errno : EIO));
-      done += static_cast<size_t>(n);
-    }
-    return;
-  }
   try {
+    if (json_fd >= 0) return writeOutputFd(json_fd, text, "standard output");
     writeOutputFile(path, text);
   } catch (const std::runtime_error& e) {
     throw OutputError(e.what());

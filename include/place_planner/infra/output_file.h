@@ -31,6 +31,10 @@ struct OutputTarget {
 // chain of more than 40 links, or a directory that does not exist.
 OutputTarget resolveOutput(const std::string& path);
 
+// Writes `bytes` whole to an open descriptor (retrying short writes); `name` is for the error.
+// Throws std::runtime_error.
+void writeOutputFd(int fd, const std::string& bytes, const std::string& name);
+
 // Writes `bytes` to `path` by the rules above.
 void writeOutputFile(const std::string& path, const std::string& bytes);
 

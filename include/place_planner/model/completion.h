@@ -27,18 +27,29 @@ struct CompletionCap {
 };
 
 struct Completion {
-  Mesh mesh;                       // the object with every open region capped (or the input)
+  const Mesh* source = nullptr;    // the object given (not owned: it outlives the plan)
+  Mesh capped;                     // the object with every open region capped, when completed()
   std::vector<CompletionCap> caps;  // empty: the mesh was closed
   double open_perimeter = 0;       // m, summed over the loops
   bool completed() const { return !caps.empty(); }
+  // What is planned on: the capped mesh, or the object itself when it was closed.
+  const Mesh& mesh() const { return completed() ? capped : *source; }
 };
 
-// Edges of exactly one triangle (vertex indices): the borders of what a scan saw. Empty for a
-// closed mesh and for a triangle soup (more than half the edges open: no shared vertices).
+// Edges of exactly one triangle (vertex indices, in the direction they run in that triangle):
+// the borders of what a scan saw. Empty for a closed mesh and for a triangle soup (more than
+// half the edges open: no shared vertices).
 std::vector<std::array<int, 2>> openEdges(const Mesh& mesh);
 
-// Caps every loop of boundary edges of `object` (edges of one triangle). A triangle soup
-// (more than half the edges open: no shared vertices) is returned as it is.
+// Distance from p to the segment ab.
+double segmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
+// True when p lies within `margin` of one of the edges (the area's open_edges, scene.h).
+bool nearOpenEdge(const std::vector<std::array<Eigen::Vector3d, 2>>& edges, const Eigen::Vector3d& p, double margin);
+
+// Caps every loop of boundary edges of `object` (edges of one triangle). A closed mesh or a
+// triangle soup (more than half the edges open: no shared vertices) is not copied: mesh() is
+// `object` itself, which must outlive the result.
 Completion completeOpenRegions(const Mesh& object);
 
 // True when the contact point p_O (on the object's surface, frame O) lies on a cap: within

@@ -79,8 +79,7 @@ void commit(const std::string& temp, const std::string& path) {
 void writeInPlace(const OutputTarget& t, const std::string& bytes) {
   if (t.kind == OutputTarget::Kind::kStdout) {
     std::fflush(stdout);
-    if (const int err = writeAll(STDOUT_FILENO, bytes)) throw failure("cannot write", "standard output", err);
-    return;
+    return writeOutputFd(STDOUT_FILENO, bytes, "standard output");
   }
   // No O_CREAT, no O_TRUNC: the device, FIFO or socket stays what it is.
   const int fd = open(t.path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
@@ -91,6 +90,10 @@ void writeInPlace(const OutputTarget& t, const std::string& bytes) {
 }
 
 }  // namespace
+
+void writeOutputFd(int fd, const std::string& bytes, const std::string& name) {
+  if (const int err = writeAll(fd, bytes)) throw failure("cannot write", name, err);
+}
 
 OutputTarget resolveOutput(const std::string& path) {
   OutputTarget t;

@@ -80,6 +80,12 @@ struct Candidate {
   SupportKind support = SupportKind::kSeen;
   bool completed_support() const { return support != SupportKind::kSeen; }
   double reorientation = 0.0;      // rad, rotation from the held orientation to the goal
+  // The largest horizontal push its contacts resist, in weights (judgement/contact_forces.h):
+  // the smallest over 8 directions, their mean, and the weakest direction (W, horizontal).
+  // Capped at 1 (a push of the full weight); 0 when not stable or not computed.
+  double push_resistance = 0.0;
+  double push_resistance_mean = 0.0;
+  Eigen::Vector3d push_weakest_W = Eigen::Vector3d::UnitX();
   std::vector<ContactPoint> contacts;                       // at the goal pose
   Eigen::Vector3d floor_point_W = Eigen::Vector3d::Zero();
   // Ordered: pre-placement pose above the floor point first, one per translation or rotation,

@@ -208,6 +208,10 @@ void toMsg(const Candidate& c, const std::string& frame_id, const std::string& g
   msg->quality = c.quality;
   msg->stable = c.stable;
   msg->support = toString(c.support);
+  msg->push_resistance = c.push_resistance;
+  msg->push_resistance_mean = c.push_resistance_mean;
+  msg->push_weakest_direction.header = msg->pose.header;
+  toMsg(c.push_weakest_W, &msg->push_weakest_direction.vector);
   msg->robust_share = c.robustness.share();
   msg->robust_trials = c.robustness.trials;
   msg->min_tipping_angle = c.robustness.min_tipping_angle;

@@ -111,7 +111,8 @@ visualization_msgs::MarkerArray buildMarkers(const Mesh& object_O, const Mesh& a
     Marker object = makeMarker(o, marker_ns::kCandidates, i, Marker::TRIANGLE_LIST);
     toMsg(c.X_WO, &object.pose);
     float r, g, b;
-    qualityColour(c.stable ? c.quality : 0.0, &r, &g, &b);
+    // Colour: the push it resists (mean over directions; green at half its weight or more).
+    qualityColour(c.stable ? std::min(1.0, c.push_resistance_mean / 0.5) : 0.0, &r, &g, &b);
     setColour(&object, r, g, b, kCandidateAlpha);
     addTriangles(object_O, &object);
     array.markers.push_back(object);
@@ -124,8 +125,9 @@ visualization_msgs::MarkerArray buildMarkers(const Mesh& object_O, const Mesh& a
       toMsg(above, &text.pose.position);
       text.scale.z = 0.03;  // text height
       setColour(&text, 1.0f, 1.0f, 1.0f, 1.0f);
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "#%d Q=%.2f%s%s", i + 1, c.quality, c.stable ? "" : " (unstable)",
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "#%d Q=%.2f push=%.2f%s%s", i + 1, c.quality, c.push_resistance_mean,
+                    c.stable ? "" : " (unstable)",
                     c.support == SupportKind::kSeen ? "" : c.support == SupportKind::kCompleted ? " (on unseen: completed)"
                                                                                                  : " (on unseen: area border)");
       text.text = buf;

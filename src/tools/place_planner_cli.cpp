@@ -258,6 +258,8 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
         {"quality", k.quality},
         {"stable", k.stable},
         {"support", toString(k.support)},
+        {"push_resistance",
+         {{"min", k.push_resistance}, {"mean", k.push_resistance_mean}, {"weakest_direction", vecJson(k.push_weakest_W)}}},
         {"start", toString(k.start)},
         {"robustness",
          {{"trials", k.robustness.trials},

@@ -10,6 +10,7 @@
 #include "place_planner/planner.h"
 #include "place_planner/search/pre_orientation.h"
 #include "place_planner/judgement/quality.h"
+#include "place_planner/judgement/contact_forces.h"
 #include "place_planner/judgement/stability.h"
 #include "place_planner/search/tilt_axis.h"
 #include "test_helpers.h"
@@ -221,11 +222,11 @@ TEST(Stability, SlopeFrictionAndEquilibrium) {
       {{0, 0.05, 0.0}, Eigen::Vector3d(0, -std::sin(0.35), std::cos(0.35))},
       {{0.05, -0.05, 0.0}, Eigen::Vector3d(0, std::sin(0.35), std::cos(0.35))},
       {{0.05, 0.05, 0.0}, Eigen::Vector3d(0, -std::sin(0.35), std::cos(0.35))}};
-  EXPECT_TRUE(equilibrium(v, Eigen::Vector3d(0.025, 0, 0.05), Eigen::Vector3d(0, 0, -1), 0.2, 0.05));
+  EXPECT_TRUE(equilibrium(v, Eigen::Vector3d(0.025, 0, 0.05), Eigen::Vector3d(0, 0, -1), 0.2));
   // One side alone cannot hold it at mu = 0.2.
   v.resize(1);
   v.push_back({{0.05, -0.05, 0.0}, Eigen::Vector3d(0, std::sin(0.35), std::cos(0.35))});
-  EXPECT_FALSE(equilibrium(v, Eigen::Vector3d(0.025, 0, 0.05), Eigen::Vector3d(0, 0, -1), 0.2, 0.05));
+  EXPECT_FALSE(equilibrium(v, Eigen::Vector3d(0.025, 0, 0.05), Eigen::Vector3d(0, 0, -1), 0.2));
 }
 
 TEST(Quality, HullHelpers) {

@@ -9,6 +9,7 @@
 #include "place_planner/planner.h"
 #include "place_planner/search/resting_faces.h"
 #include "place_planner/judgement/robustness.h"
+#include "place_planner/judgement/contact_forces.h"
 #include "place_planner/judgement/stability.h"
 #include "place_planner/search/tree_stepper.h"
 #include "test_helpers.h"
@@ -409,13 +410,13 @@ TEST(Stability, WedgeNeedsSqueezeAndIsNotStable) {
   const std::vector<ContactPoint> wedge = {{{-0.02, 0, 0}, {1, 0, 0}}, {{0.02, 0, 0}, {-1, 0, 0}},
                                            {{-0.02, 0.01, 0}, {1, 0, 0}}, {{0.02, 0.01, 0}, {-1, 0, 0}}};
   const Eigen::Vector3d com(0, 0.005, 0);
-  EXPECT_FALSE(equilibrium(wedge, com, Eigen::Vector3d(0, 0, -1), 0.2, 0.02));
+  EXPECT_FALSE(equilibrium(wedge, com, Eigen::Vector3d(0, 0, -1), 0.2));
   // With unbounded squeeze the same contacts balance gravity: the bound is what rejects it.
-  EXPECT_TRUE(equilibrium(wedge, com, Eigen::Vector3d(0, 0, -1), 0.2, 0.02, 1e6));
+  EXPECT_TRUE(equilibrium(wedge, com, Eigen::Vector3d(0, 0, -1), 0.2, 1e6));
   // A floor loads its contacts with the weight alone.
   const std::vector<ContactPoint> floor = {{{-0.02, -0.02, 0}, {0, 0, 1}}, {{0.02, -0.02, 0}, {0, 0, 1}},
                                            {{0, 0.02, 0}, {0, 0, 1}}};
-  EXPECT_TRUE(equilibrium(floor, Eigen::Vector3d(0, 0, 0.01), Eigen::Vector3d(0, 0, -1), 0.2, 0.02));
+  EXPECT_TRUE(equilibrium(floor, Eigen::Vector3d(0, 0, 0.01), Eigen::Vector3d(0, 0, -1), 0.2));
 }
 
 TEST(Stability, ContactsFromAboveNeverHold) {

@@ -628,7 +628,7 @@ TEST(PlacePlannerNode, FeedbackDuringLongPlanAndDocumentedMarkers) {
     EXPECT_EQ(ns.count(expected), 1u) << "namespace " << expected << " missing";
   }
   EXPECT_EQ(ns.size(), 8u) << "without a grasp: no gripper, no retreat";
-  // One object per candidate (up to marker_candidates = 10), coloured by Q.
+  // One object per candidate (up to marker_candidates = 10), coloured by the push it resists.
   int objects = 0;
   for (const auto& m : batch.markers) objects += m.ns == marker_ns::kCandidates;
   EXPECT_EQ(objects, std::min<int>(10, a.result.candidates.size()));

@@ -12,6 +12,7 @@ struct StabilityParams {
   double tol = 0.003;             // m, contacts within tol of a plane are coplanar
   double min_tipping_angle = 0.2; // rad: a pose that tips over with less tilt is not stable
   double min_support_width = 0.0; // m: narrower support polygons (a wall top, a rim) do not hold
+  double max_load = 3.0;          // contact forces: total normal force bound, in weights
 };
 
 enum class Failure { kNone, kSlide, kTip };
@@ -19,6 +20,9 @@ enum class Failure { kNone, kSlide, kTip };
 struct Stability {
   bool planar = false;     // all contacts on one plane P (the paper's planar case)
   bool stable = false;
+  // Gravity alone is balanced by the contact forces (no margin): at rest if nothing lower is
+  // near (the rock settle looks), though not stable.
+  bool balanced = false;
   bool friction_ok = false;
   bool com_inside = false;
   double quality = -1.0;   // Q
@@ -39,24 +43,11 @@ struct Stability {
 // robustness) a tipping angle of at least min_tipping_angle and a support polygon at least
 // min_support_width wide (checked in Bullet: objects balanced on 1 cm walls fall). Failure direction d_f =
 // c^_O - c^_Omega (tipping) or down the slope (sliding).
-// Non-planar case: the paper's heuristic (contacts whose normal lies in the friction cone about
-// -d_g form Omega' and are tested like the planar case), then an equilibrium test: non-negative
-// forces in the contacts' friction cones balance gravity, also with gravity tilted by half the
-// friction angle (section "non-planar" in stability.cpp).
+// Non-planar case: the contact forces decide (contact_forces.h): non-negative forces in the
+// contacts' friction cones balance gravity, also with gravity tilted by half the friction angle
+// towards 8 directions; the paper's heuristic support polygon Omega' (contacts whose normal lies
+// in the friction cone about -d_g) gives Q and the failure direction.
 Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                             const StabilityParams& params);
-
-// Lawson-Hanson non-negative least squares: min |A x - b| with x >= 0. Returns the residual norm.
-double nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd* x = nullptr);
-
-// True when non-negative contact forces inside friction pyramids (4 edges, inscribed) balance
-// the force `f_ext` applied at `com` (force and torque) with a total normal force of at most
-// max_load |f_ext|: the least loaded balancing forces are found. Gravity alone loads a floor,
-// a V-groove or a leaning support with about 1-1.5 times the weight; a wedge held between walls
-// by squeeze needs at least |f_ext| / mu, so with the default bound of 2 (and mu <= 0.25) a
-// statically indeterminate wedge is not accepted.
-bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
-                 const Eigen::Vector3d& f_ext, double friction, double length_scale,
-                 double max_load = 2.0);
 
 }  // namespace place_planner

@@ -37,6 +37,7 @@ struct TreeNode {
   int roll = 0;
   double roll_margin = 0;
   int rocks = 0;          // rock settle steps taken (rockStep)
+  bool held = false;      // its last stability test held it with margin (rocked when only balanced)
   bool overhang = false;  // its last pose was past its support over a drop (see fall_tip)
 };
 

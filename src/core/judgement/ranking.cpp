@@ -4,12 +4,19 @@
 #include <algorithm>
 #include <cmath>
 
+#include "place_planner/judgement/contact_forces.h"
 #include "place_planner/search/contact_points.h"
 #include "place_planner/manipulation/placeability.h"
 #include "place_planner/infra/stable_sort.h"
 
 namespace place_planner {
 namespace {
+
+// The push a pose resists (contact_forces.h), mean over 8 directions in weights, adds to the
+// score with this weight: on a flat area every wide pose resists about mu and Q decides; a pose
+// the area holds (a plate between pegs, a box in a slot, a pen in a cup) resists pushes that
+// would slide the same pose off a flat top. See doc/method.md ("Push resistance").
+constexpr double kPushWeight = 0.25;
 
 struct Item {
   size_t leaf;
@@ -20,9 +27,11 @@ struct Item {
   long preference = 0;  // config.rank_order's key, lower first
   Placement placement;
   SupportKind support = SupportKind::kSeen;  // on unseen surface: after the seen ones
+  PushResistance push;
+  bool pushed = false;  // push computed
   double score() const {
     const double share = checked ? robustness.share() : 1.0;
-    return quality - 0.05 * reorientation / M_PI - 0.05 * (1.0 - share);
+    return quality - 0.05 * reorientation / M_PI - 0.05 * (1.0 - share) + kPushWeight * push.mean;
   }
 };
 
@@ -179,10 +188,26 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     }
     sortItems(distinct, leaves);
   }
+  // Push resistance of the stable candidates to be returned (bounded: max_candidates of them),
+  // from the contacts in cells of a tenth of the object's radius; they are ranked again with it.
+  auto returned = [&](const Item& it) {
+    return !(place && !it.placement.checked) && (it.placement.blocked.empty() || config.keep_colliding);
+  };
+  const ForceModelParams forces{config.friction, 8, 3.0};
+  int pushed = 0;
+  for (Item& it : distinct) {
+    if (pushed >= config.max_candidates) break;
+    if (!returned(it) || !it.stable) continue;
+    const TreeLeaf& l = leaves[it.leaf];
+    it.push = pushResistance(reduceContacts(l.contacts, in.object_radius / 10.0), toIsometry(l.X_GO) * in.com_O, forces,
+                             1.0, std::min(0.003, in.object_radius / 10.0));
+    it.pushed = true;
+    ++pushed;
+  }
+  sortItems(distinct, leaves);
   for (const Item& it : distinct) {
     if (static_cast<int>(out.size()) >= config.max_candidates) break;
-    if (place && !it.placement.checked) continue;
-    if (!it.placement.blocked.empty() && !config.keep_colliding) continue;
+    if (!returned(it)) continue;
     const TreeLeaf& l = leaves[it.leaf];
     Candidate c;
     const Eigen::Isometry3d X_GO = toIsometry(l.X_GO);
@@ -194,6 +219,11 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     c.robustness = it.robustness;
     c.start = in.root_kind[l.root];
     c.reorientation = it.reorientation;
+    if (it.pushed) {
+      c.push_resistance = it.push.min;
+      c.push_resistance_mean = it.push.mean;
+      c.push_weakest_W = R_WG * it.push.weakest;
+    }
     // The result summarises the contacts in cells of a third of the object's radius.
     for (const auto& p : reduceContacts(l.contacts, in.object_radius / 3.0))
       c.contacts.push_back({R_WG * p.p_W, R_WG * p.n_W});

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "place_planner/judgement/contact_forces.h"
 #include "place_planner/judgement/quality.h"
 
 namespace place_planner {
@@ -133,98 +134,35 @@ Eigen::Vector3d farthest(const std::vector<ContactPoint>& c, const Eigen::Vector
   return best;
 }
 
+// The contact forces (contact_forces.h) on the contacts merged in cells of an eighth of their
+// extent (at least the contact tolerance): a few dozen at most, so the NNLS stays small whatever
+// the sphere model's density.
+ContactForces forceModel(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                         const StabilityParams& prm) {
+  double extent = 0;
+  for (const ContactPoint& p : contacts) extent = std::max(extent, (p.p_W - contacts.front().p_W).norm());
+  return ContactForces(mergeContacts(contacts, std::max(prm.tol, extent / 8)), com,
+                       ForceModelParams{prm.friction, 8, prm.max_load});
+}
+
+// The contact forces balance gravity, and gravity tilted by half the friction angle towards each
+// of 8 horizontal directions (a margin against sliding and tipping).
+bool balancedWithMargin(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                        const StabilityParams& prm, bool* balanced = nullptr) {
+  const ContactForces forces = forceModel(contacts, com, prm);
+  const bool at_all = forces.balances(-kUp);
+  if (balanced) *balanced = at_all;
+  if (!at_all) return false;
+  const double tilt = 0.5 * std::atan(prm.friction);
+  for (int k = 0; k < 8; ++k) {
+    const double phi = k * M_PI / 4;
+    if (!forces.balances(Eigen::Vector3d(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi), -std::cos(tilt))))
+      return false;
+  }
+  return true;
+}
+
 }  // namespace
-
-double nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::VectorXd* xout) {
-  const int n = static_cast<int>(A.cols());
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
-  std::vector<bool> passive(n, false);
-  const double tol = 1e-10 * (1.0 + A.cwiseAbs().maxCoeff());
-  for (int outer = 0; outer < 3 * n + 10; ++outer) {
-    Eigen::VectorXd w = A.transpose() * (b - A * x);
-    int t = -1;
-    double wmax = tol;
-    for (int j = 0; j < n; ++j)
-      if (!passive[j] && w[j] > wmax) {
-        wmax = w[j];
-        t = j;
-      }
-    if (t < 0) break;
-    passive[t] = true;
-    for (int inner = 0; inner < 3 * n + 10; ++inner) {
-      std::vector<int> P;
-      for (int j = 0; j < n; ++j)
-        if (passive[j]) P.push_back(j);
-      Eigen::MatrixXd Ap(A.rows(), P.size());
-      for (size_t k = 0; k < P.size(); ++k) Ap.col(k) = A.col(P[k]);
-      const Eigen::VectorXd zp = Ap.colPivHouseholderQr().solve(b);
-      Eigen::VectorXd z = Eigen::VectorXd::Zero(n);
-      bool ok = true;
-      for (size_t k = 0; k < P.size(); ++k) {
-        z[P[k]] = zp[k];
-        if (zp[k] <= 0) ok = false;
-      }
-      if (ok) {
-        x = z;
-        break;
-      }
-      double alpha = 1.0;
-      for (int j : P)
-        if (z[j] <= 0) alpha = std::min(alpha, x[j] / (x[j] - z[j]));
-      x += alpha * (z - x);
-      for (int j : P)
-        if (x[j] <= tol) {
-          passive[j] = false;
-          x[j] = 0;
-        }
-    }
-  }
-  if (xout) *xout = x;
-  return (A * x - b).norm();
-}
-
-bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
-                 const Eigen::Vector3d& f_ext, double friction, double L, double max_load) {
-  if (contacts.empty()) return false;
-  // Inscribed 4-edge pyramid: conservative against the true cone.
-  const double mu = friction / std::sqrt(2.0);
-  const int m = static_cast<int>(4 * contacts.size());
-  // Rows: force (3), torque (3), and a small weight on the total normal force, so that of all
-  // balancing forces the least loaded is found (a wedge's squeeze is not free).
-  constexpr double kLoadWeight = 1e-3;
-  Eigen::MatrixXd A(7, m);
-  for (size_t i = 0; i < contacts.size(); ++i) {
-    const Eigen::Vector3d n = contacts[i].n_W.normalized();
-    const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
-    const Eigen::Vector3d r = contacts[i].p_W - com;
-    const Eigen::Vector3d e[4] = {n + mu * (t1 + t2), n + mu * (t1 - t2), n - mu * (t1 + t2),
-                                  n - mu * (t1 - t2)};
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d f = e[k].normalized();
-      A.block<3, 1>(0, 4 * i + k) = f;
-      A.block<3, 1>(3, 4 * i + k) = r.cross(f) / L;  // torques in units of force
-      A(6, 4 * i + k) = kLoadWeight * f.dot(n);
-    }
-  }
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(7), x;
-  b.head<3>() = -f_ext;
-  nnls(A, b, &x);
-  const double residual = (A.topRows(6) * x - b.head<6>()).norm();
-  const double load = A.row(6).dot(x) / kLoadWeight;  // sum of normal forces
-  return residual < 1e-4 * f_ext.norm() && load <= max_load * f_ext.norm();
-}
-
-// Support polygon of `pts` seen along `dir` (a plane through the centre of mass with normal
-// dir), with the centre of mass inside-test; the 2D analysis of analyse() without gravity.
-Support analyse2(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& dir,
-                 const Eigen::Vector3d& com) {
-  Support s;
-  if (!projectHull(s, pts, com, dir)) return s;
-  s.c_hat_O = Eigen::Vector2d::Zero();
-  s.inside = signedBoundaryDistance(s.hull2, s.c_hat_O);
-  s.valid = true;
-  return s;
-}
 
 Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                             const StabilityParams& prm) {
@@ -251,6 +189,14 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   Eigen::Vector3d nbar = Eigen::Vector3d::Zero();
   for (const auto& p : contacts) nbar += p.n_W;
   const bool from_below = nbar.dot(kUp) > 0;
+  // The planar test is the contact-force model's closed form when the contacts are faces on the
+  // plane (forces along its normal balance gravity exactly when c^_O lies in Omega). A contact's
+  // normal blends the object's and the area's (sphereContact), so where either surface is the
+  // plane's face it lies within 45 degrees of the plane's normal. A normal farther off proves
+  // neither is (box edges against the walls of a V-groove, a body between two walls): then the
+  // force model must balance gravity too (a squeeze between walls does not).
+  bool faces_on_plane = true;
+  for (const auto& p : contacts) faces_on_plane = faces_on_plane && p.n_W.dot(n) >= std::cos(M_PI / 4) - 1e-9;
   if (off <= prm.tol && spread2 > prm.tol && n.dot(kUp) > 1e-3) {
     r.planar = true;
     r.plane_normal = n;
@@ -263,6 +209,11 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     r.friction_ok = std::acos(std::clamp(n.dot(kUp), -1.0, 1.0)) < cone;  // angle(P, -d_g) < atan(mu)
     r.stable = from_below && r.friction_ok && r.com_inside && s.tip >= prm.min_tipping_angle && s.quality >= 0.3 &&
                polygonWidth(s.hull2) >= prm.min_support_width;
+    // The planar test has its own margins (tipping angle, Q); the force model only has to
+    // balance gravity where the normals leave the plane's (a squeeze between walls does not).
+    // Failing it, the pose is still balanced on the plane: the rock settle looks for a lower one.
+    r.balanced = r.stable;
+    if (r.stable && !faces_on_plane) r.stable = forceModel(contacts, com, prm).balances(-kUp);
     if (r.stable) {
       r.failure = Failure::kNone;
     } else if (!r.friction_ok) {
@@ -278,8 +229,14 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     return r;
   }
   // ---------------------------------------------------------------- non-planar case
-  // Paper's heuristic, first step: contacts whose normal lies in the friction cone about -d_g
-  // support like a floor; their support polygon Omega' is tested as in the planar case.
+  // The paper's heuristic (contacts whose normal lies in the friction cone about -d_g form
+  // Omega', tested like the planar case) gives Q and the failure direction for the local
+  // optimisation. Stability is decided by the contact forces (contact_forces.h): forces in
+  // the contacts' friction cones balance gravity, and gravity tilted by half the friction angle
+  // towards each of 8 horizontal directions (a margin against sliding and tipping, the force
+  // model's form of the planar case's tipping angle). This accepts leaning (a pen in a cup, a
+  // plate against a peg) and gravity-loaded wedging, and rejects a ball on one point, a body on
+  // a line of contacts, and a squeeze between parallel walls.
   std::vector<Eigen::Vector3d> below;
   double zmin = 1e300;
   for (const auto& p : contacts) {
@@ -302,56 +259,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     r.quality = ref.quality;
     r.com_inside = ref.inside >= 0;
   }
-  bool stable = s1.valid && s1.inside >= 0 && s1.tip >= prm.min_tipping_angle && s1.quality >= 0.3 &&
-                polygonWidth(s1.hull2) >= prm.min_support_width;
-  if (!stable && !below.empty()) {
-    // Paper's heuristic, second step: the object would move along d'_f = c_O - c(Omega')
-    // (horizontal); contacts whose normal opposes d'_f catch it. With gravity replaced by
-    // d'_f, the supporting contacts (below and opposing) form Omega''; the centre of mass
-    // must project into it along d'_f (a pen leaning from a cup's floor against its rim).
-    Eigen::Vector3d cb = Eigen::Vector3d::Zero();
-    for (const auto& p : below) cb += p;
-    cb /= static_cast<double>(below.size());
-    Eigen::Vector3d df = com - cb;
-    df.z() = 0;
-    if (df.norm() > 1e-6) {
-      df.normalize();
-      // Opposing contacts: normal within the friction cone about -d'_f (the paper's condition).
-      std::vector<Eigen::Vector3d> support = below;
-      int opposing = 0;
-      for (const auto& p : contacts)
-        if (p.n_W.dot(-df) > std::cos(cone)) {
-          support.push_back(p.p_W);
-          ++opposing;
-        }
-      if (opposing > 0) {
-        const Support s2 = analyse2(support, df, com);
-        // Omega'' must face d'_f or the floor within the friction angle (the paper's test):
-        // the normal of the plane through its contacts.
-        const auto& es2 = fitPlane(support).eigen;
-        const Eigen::Vector3d n2 = es2.eigenvectors().col(0);
-        const bool spans = es2.eigenvalues()(1) > prm.tol * prm.tol;
-        const double to_df = std::acos(std::min(1.0, std::abs(n2.dot(df))));
-        const double to_up = std::acos(std::min(1.0, std::abs(n2.dot(kUp))));
-        stable = s2.valid && s2.inside >= 0 && spans && std::min(to_df, to_up) < cone;
-      }
-    }
-  }
-  if (!stable) {
-    // Equilibrium: forces within the friction cones balance gravity, also with gravity tilted
-    // by half the friction angle in four directions (a margin against sliding and tipping).
-    const double L = std::max(1e-3, (com - c).norm());
-    const double tilt = 0.5 * cone;
-    stable = equilibrium(contacts, com, -kUp, prm.friction, L);
-    for (int k = 0; k < 4 && stable; ++k) {
-      const double phi = k * M_PI / 2;
-      const Eigen::Vector3d g(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi),
-                              -std::cos(tilt));
-      stable = equilibrium(contacts, com, g, prm.friction, L);
-    }
-  }
-  // One contact or a line of contacts never holds (a ball rolls, a cylinder turns about it).
-  if (spread2 <= 0.1 * prm.tol) stable = false;
+  const bool stable = balancedWithMargin(contacts, com, prm, &r.balanced);
   r.friction_ok = stable;
   r.stable = stable;
   if (stable) {

@@ -293,7 +293,11 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
       rotating_.push_back(std::move(n));
     } else if (line) {
       leaf(false, false);  // still tilting when the tree was cut
-    } else if (s.stable && ctx_.rock_settle && n.rocks < kMaxRocks && !flatSupport(s, n.contacts)) {
+    } else if ((s.stable || s.balanced) && ctx_.rock_settle && n.rocks < kMaxRocks &&
+               !flatSupport(s, n.contacts)) {
+      // Held, or balanced by the contact forces without their margin (propped a few degrees
+      // off on domes or a rim): the rock settle finds whether it sinks to a lower pose.
+      n.held = s.stable;
       rocking_.push_back(std::move(n));
     } else if (s.stable) {
       leaf(true, true);
@@ -617,7 +621,7 @@ void TreeStepper::rockStep(std::vector<TreeLeaf>& leaves) {
       }
       // Rocked down between steep contacts facing each other, it hangs in a V of edges.
       const bool wedged = n.rocks > 0 && hangsBetweenEdges(n.contacts);
-      leaves.push_back(TreeLeaf{n.X_GO, n.root, !wedged, true, n.supported && !wedged, n.quality, n.tipping_angle, n.contacts, n.path});
+      leaves.push_back(TreeLeaf{n.X_GO, n.root, n.held && !wedged, true, n.supported && !wedged, n.quality, n.tipping_angle, n.contacts, n.path});
       continue;
     }
     if (kTrace) std::fprintf(stderr, "root %d rocks %d by %.1f um\n", n.root, best, (h[0] - h[best]) * 1e6);

@@ -1,0 +1,171 @@
+// The contact-force model (judgement/contact_forces.h) and the stability it decides
+// (judgement/stability.h, non-planar case): closed-form statics on both sides of each limit.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "place_planner/judgement/contact_forces.h"
+#include "place_planner/judgement/stability.h"
+
+namespace place_planner {
+namespace {
+
+const Eigen::Vector3d kGravity(0, 0, -1);
+
+// A rod of length l at angle theta from the floor, its foot on the floor (normal +z) and its top
+// against a wall at x = 0 (normal -x); two contacts each end, 2 cm apart across the rod.
+std::vector<ContactPoint> ladder(double theta, double l, Eigen::Vector3d* com) {
+  const Eigen::Vector3d foot(-l * std::cos(theta), 0, 0), top(0, 0, l * std::sin(theta));
+  *com = 0.5 * (foot + top);
+  std::vector<ContactPoint> c;
+  for (double y : {-0.01, 0.01}) {
+    c.push_back({foot + Eigen::Vector3d(0, y, 0), Eigen::Vector3d::UnitZ()});
+    c.push_back({top + Eigen::Vector3d(0, y, 0), -Eigen::Vector3d::UnitX()});
+  }
+  return c;
+}
+
+TEST(ContactForces, LadderHoldsExactlyAboveTheFrictionAngle) {
+  // A uniform ladder with friction mu at floor and wall holds when tan(theta) >= (1 - mu^2) / (2 mu).
+  for (double mu : {0.3, 0.5, 0.7}) {
+    const double critical = std::atan((1 - mu * mu) / (2 * mu));
+    for (double delta_deg : {-3.0, -1.0, 1.0, 3.0}) {
+      const double theta = critical + delta_deg * M_PI / 180.0;
+      Eigen::Vector3d com;
+      const auto c = ladder(theta, 0.4, &com);
+      EXPECT_EQ(equilibrium(c, com, kGravity, mu), delta_deg > 0)
+          << "mu " << mu << " theta " << theta * 180 / M_PI << " deg (critical " << critical * 180 / M_PI << ")";
+    }
+  }
+  // Without the wall the rod falls whatever its angle.
+  Eigen::Vector3d com;
+  auto c = ladder(1.2, 0.4, &com);
+  c.erase(std::remove_if(c.begin(), c.end(), [](const ContactPoint& p) { return p.n_W.z() < 0.5; }), c.end());
+  EXPECT_FALSE(equilibrium(c, com, kGravity, 0.7));
+}
+
+// A 4 cm box whose lower edges touch two walls at `wall_deg` from the horizontal (a V-groove).
+std::vector<ContactPoint> vGroove(double wall_deg, bool both_walls) {
+  const double a = wall_deg * M_PI / 180.0;
+  std::vector<ContactPoint> c;
+  for (double y : {-0.02, 0.02}) {
+    c.push_back({{-0.02, y, 0}, {std::sin(a), 0, std::cos(a)}});
+    if (both_walls) c.push_back({{0.02, y, 0}, {-std::sin(a), 0, std::cos(a)}});
+  }
+  return c;
+}
+
+TEST(ContactForces, GravityWedgesABoxBetweenSteepWallsButNotAgainstOne) {
+  StabilityParams p;  // mu 0.2
+  const Eigen::Vector3d com(0, 0, 0.02);
+  for (double wall : {45.0, 60.0, 70.0}) {
+    const Stability both = evaluateStability(vGroove(wall, true), com, p);
+    EXPECT_TRUE(both.stable) << wall << " degree walls";
+    EXPECT_FALSE(evaluateStability(vGroove(wall, false), com, p).stable) << wall << " degree wall alone";
+  }
+  // Parallel vertical walls hold only by a squeeze of at least weight / mu: not relied on.
+  EXPECT_FALSE(evaluateStability(vGroove(90.0, true), com, p).stable);
+}
+
+TEST(ContactForces, SphereRestsInACupNotOnOnePoint) {
+  const double R = 0.03;
+  const Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  StabilityParams p;
+  // In a cup whose bottom is narrower than the sphere it rests on a ring of contacts, normals
+  // through its centre, 30 degrees from vertical.
+  std::vector<ContactPoint> ring;
+  for (int k = 0; k < 8; ++k) {
+    const double phi = 2 * M_PI * k / 8, beta = 30.0 * M_PI / 180.0;
+    const Eigen::Vector3d q(std::sin(beta) * std::cos(phi), std::sin(beta) * std::sin(phi), -std::cos(beta));
+    ring.push_back({R * q, -q});
+  }
+  EXPECT_TRUE(evaluateStability(ring, com, p).stable);
+  // The same ring off-centre (the sphere against one side of the cup): one side only, it rolls.
+  std::vector<ContactPoint> side(ring.begin(), ring.begin() + 3);
+  EXPECT_FALSE(evaluateStability(side, com, p).stable);
+  // On a table: one contact under its centre. Gravity alone is balanced (an unstable equilibrium),
+  // the smallest tilt is not.
+  const std::vector<ContactPoint> point = {{{0, 0, -R}, {0, 0, 1}}};
+  EXPECT_TRUE(equilibrium(point, com, kGravity, 0.2));
+  EXPECT_FALSE(evaluateStability(point, com, p).stable);
+}
+
+TEST(ContactForces, LineOfContactsHoldsOnlyWithTheCentreOfMassOnIt) {
+  // A cylinder on its side: contacts along a line (x axis), on a floor.
+  std::vector<ContactPoint> line;
+  for (double x : {-0.05, 0.0, 0.05}) line.push_back({{x, 0, 0}, {0, 0, 1}});
+  EXPECT_TRUE(equilibrium(line, Eigen::Vector3d(0, 0, 0.02), kGravity, 0.2));
+  EXPECT_FALSE(equilibrium(line, Eigen::Vector3d(0, 0.002, 0.02), kGravity, 0.2));
+  EXPECT_FALSE(evaluateStability(line, Eigen::Vector3d(0, 0, 0.02), StabilityParams{}).stable);
+}
+
+TEST(ContactForces, CubeSlidesOnASlopeSteeperThanTheFrictionAngle) {
+  // The planar case's closed form (slope < atan mu) and the force model agree.
+  const double mu = 0.4;
+  for (double slope_deg : {15.0, 20.0, 23.0, 26.0, 30.0}) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(slope_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    std::vector<ContactPoint> c;
+    for (double x : {-0.02, 0.02})
+      for (double y : {-0.02, 0.02}) c.push_back({R * Eigen::Vector3d(x, y, 0), R.col(2)});
+    const Eigen::Vector3d com = R * Eigen::Vector3d(0, 0, 0.01);
+    // The pyramid's edges lie on the cone in the slope's direction here (edge at +-x of the
+    // contact frame), so the model is exact: holds below atan(0.4) = 21.8 degrees.
+    EXPECT_EQ(equilibrium(c, com, kGravity, mu), slope_deg < 21.8) << slope_deg;
+    StabilityParams p;
+    p.friction = mu;
+    EXPECT_EQ(evaluateStability(c, com, p).stable, slope_deg < 21.8) << slope_deg;
+  }
+}
+
+TEST(ContactForces, PushOnAFlatTopIsTheTippingMarginOrFriction) {
+  // A box of half-width w with its centre of mass at height h resists a push of w / h before it
+  // tips (with friction enough), and mu before it slides.
+  auto box = [](double w) {
+    std::vector<ContactPoint> c;
+    for (double x : {-w, w})
+      for (double y : {-w, w}) c.push_back({{x, y, 0}, {0, 0, 1}});
+    return c;
+  };
+  const ForceModelParams sticky{2.0, 8, 3.0};
+  const ContactForces low(box(0.04), Eigen::Vector3d(0, 0, 0.02), sticky);    // w / h = 2 -> capped at 1
+  const ContactForces tall(box(0.02), Eigen::Vector3d(0, 0, 0.08), sticky);   // w / h = 0.25
+  const ContactForces mid(box(0.03), Eigen::Vector3d(0, 0, 0.05), sticky);    // w / h = 0.6
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX();
+  EXPECT_NEAR(low.pushResistance(x), 1.0, 1e-9);
+  EXPECT_NEAR(tall.pushResistance(x), 0.25, 0.01);
+  EXPECT_NEAR(mid.pushResistance(x), 0.6, 0.01);
+  // Low and wide resists more than tall and narrow, over all directions too.
+  const PushResistance pl = pushResistance(box(0.04), Eigen::Vector3d(0, 0, 0.02), sticky);
+  const PushResistance pt = pushResistance(box(0.02), Eigen::Vector3d(0, 0, 0.08), sticky);
+  EXPECT_GT(pl.min, pt.min + 0.5);
+  // With mu = 0.2 both slide first: the push is friction's, mu cos(pi / 8) at worst.
+  const ContactForces slippery(box(0.04), Eigen::Vector3d(0, 0, 0.02), ForceModelParams{0.2, 8, 3.0});
+  EXPECT_NEAR(slippery.pushResistance(x), 0.2, 0.2 * (1 - std::cos(M_PI / 8)) + 0.01);
+  // Nothing holds without gravity balanced: a box beside its support.
+  EXPECT_EQ(ContactForces(box(0.02), Eigen::Vector3d(0.05, 0, 0.02), sticky).pushResistance(x), 0.0);
+}
+
+TEST(ContactForces, BoxInASlotResistsALargerPushThanOnAFlatTop) {
+  // A 4 x 4 x 10 cm box standing on a floor; in a slot, walls 4 cm apart (normals +-x) touch
+  // its sides 2 cm up.
+  std::vector<ContactPoint> flat;
+  for (double x : {-0.02, 0.02})
+    for (double y : {-0.02, 0.02}) flat.push_back({{x, y, 0}, {0, 0, 1}});
+  std::vector<ContactPoint> slot = flat;
+  for (double y : {-0.02, 0.02}) {
+    slot.push_back({{-0.02, y, 0.02}, {1, 0, 0}});
+    slot.push_back({{0.02, y, 0.02}, {-1, 0, 0}});
+  }
+  const Eigen::Vector3d com(0, 0, 0.05);
+  const ForceModelParams prm{0.2, 8, 3.0};
+  const PushResistance on_top = pushResistance(flat, com, prm);
+  const PushResistance in_slot = pushResistance(slot, com, prm);
+  EXPECT_GT(in_slot.by_direction[0], on_top.by_direction[0] + 0.3);  // across the slot
+  EXPECT_GT(in_slot.mean, on_top.mean + 0.1);
+  EXPECT_GE(in_slot.min, on_top.min - 0.01);  // along the slot: friction, as on the top
+  EXPECT_GT(on_top.min, 0.1);
+}
+
+}  // namespace
+}  // namespace place_planner

@@ -193,8 +193,8 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   // plane (forces along its normal balance gravity exactly when c^_O lies in Omega). A contact's
   // normal blends the object's and the area's (sphereContact), so where either surface is the
   // plane's face it lies within 45 degrees of the plane's normal. A normal farther off proves
-  // neither is (box edges against the walls of a V-groove, a body between two walls): then the
-  // force model must balance gravity too (a squeeze between walls does not).
+  // neither is (box edges against the walls of a V-groove, a body between two walls, a marker's
+  // foot and its lean across a cup): then the contact forces decide.
   bool faces_on_plane = true;
   for (const auto& p : contacts) faces_on_plane = faces_on_plane && p.n_W.dot(n) >= std::cos(M_PI / 4) - 1e-9;
   if (off <= prm.tol && spread2 > prm.tol && n.dot(kUp) > 1e-3) {
@@ -209,11 +209,16 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     r.friction_ok = std::acos(std::clamp(n.dot(kUp), -1.0, 1.0)) < cone;  // angle(P, -d_g) < atan(mu)
     r.stable = from_below && r.friction_ok && r.com_inside && s.tip >= prm.min_tipping_angle && s.quality >= 0.3 &&
                polygonWidth(s.hull2) >= prm.min_support_width;
-    // The planar test has its own margins (tipping angle, Q); the force model only has to
-    // balance gravity where the normals leave the plane's (a squeeze between walls does not).
-    // Failing it, the pose is still balanced on the plane: the rock settle looks for a lower one.
+    // Contacts that are not faces on the plane: the contact forces decide, with their margin
+    // (a marker leaning across a cup, its foot in the corner). The closed form's verdict still
+    // counts as balanced: propped on domes, the rock settle finds where it sinks.
     r.balanced = r.stable;
-    if (r.stable && !faces_on_plane) r.stable = forceModel(contacts, com, prm).balances(-kUp);
+    if (!faces_on_plane) {
+      bool forces_balance = false;
+      r.stable = balancedWithMargin(contacts, com, prm, &forces_balance);
+      r.balanced = r.balanced || forces_balance;
+      r.friction_ok = r.friction_ok || r.stable;
+    }
     if (r.stable) {
       r.failure = Failure::kNone;
     } else if (!r.friction_ok) {

@@ -45,7 +45,7 @@ struct Stability {
 // c^_O - c^_Omega (tipping) or down the slope (sliding).
 // Non-planar case: the contact forces decide (contact_forces.h): non-negative forces in the
 // contacts' friction cones balance gravity, also with gravity tilted by half the friction angle
-// towards 8 directions; the paper's heuristic support polygon Omega' (contacts whose normal lies
+// towards 4 directions; the paper's heuristic support polygon Omega' (contacts whose normal lies
 // in the friction cone about -d_g) gives Q and the failure direction.
 Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                             const StabilityParams& params);

@@ -146,7 +146,7 @@ ContactForces forceModel(const std::vector<ContactPoint>& contacts, const Eigen:
 }
 
 // The contact forces balance gravity, and gravity tilted by half the friction angle towards each
-// of 8 horizontal directions (a margin against sliding and tipping).
+// of the 4 horizontal axis directions of G (a margin against sliding and tipping).
 bool balancedWithMargin(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                         const StabilityParams& prm, bool* balanced = nullptr) {
   const ContactForces forces = forceModel(contacts, com, prm);
@@ -154,8 +154,8 @@ bool balancedWithMargin(const std::vector<ContactPoint>& contacts, const Eigen::
   if (balanced) *balanced = at_all;
   if (!at_all) return false;
   const double tilt = 0.5 * std::atan(prm.friction);
-  for (int k = 0; k < 8; ++k) {
-    const double phi = k * M_PI / 4;
+  for (int k = 0; k < 4; ++k) {
+    const double phi = k * M_PI / 2;
     if (!forces.balances(Eigen::Vector3d(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi), -std::cos(tilt))))
       return false;
   }
@@ -238,7 +238,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   // Omega', tested like the planar case) gives Q and the failure direction for the local
   // optimisation. Stability is decided by the contact forces (contact_forces.h): forces in
   // the contacts' friction cones balance gravity, and gravity tilted by half the friction angle
-  // towards each of 8 horizontal directions (a margin against sliding and tipping, the force
+  // towards each of the 4 axis directions of G (a margin against sliding and tipping, the force
   // model's form of the planar case's tipping angle). This accepts leaning (a pen in a cup, a
   // plate against a peg) and gravity-loaded wedging, and rejects a ball on one point, a body on
   // a line of contacts, and a squeeze between parallel walls.

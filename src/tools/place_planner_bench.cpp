@@ -15,6 +15,7 @@
 #include <string>
 
 #include "place_planner/infra/output_file.h"
+#include "place_planner/infra/scenes.h"
 #include "place_planner/infra/cuda_backend.h"
 #include "place_planner/search/floor_points.h"
 #include "place_planner/infra/mesh_io.h"
@@ -131,6 +132,38 @@ void BM_BooksStackCudaCold(benchmark::State& s) {
 void BM_BooksStackCudaPrincipalAxis(benchmark::State& s) {
   runPlan(s, "areas/books_stack.ply", true, OrientationMode::kPrincipalAxis, BackendKind::kCuda);
 }
+// An area approached from the side: the built-in shelf unit (scenes::shelfUnit, 15k triangles,
+// 2.4 m tall, open to -y), the 1k mug along d_vis = +y, about 200 floor points, cold.
+void BM_ShelfFromSideCold(benchmark::State& state) {
+  const Mesh* object = mesh("objects/mug_ycb025_1k.ply");
+  if (!object) {
+    state.SkipWithError(("../shared/data not found at " + g_data).c_str());
+    return;
+  }
+  static const Mesh shelf = scenes::shelfUnit();
+  PlannerConfig cfg;
+  cfg.approach = Eigen::Vector3d(0, 1, 0);
+  cfg.floor_point_spacing = 0.11;
+  cfg.threads = 2;
+  static const Planner planner;
+  PlanResult r;
+  double contacts = 0, setup = 0;
+  for (auto _ : state) {
+    planner.clearAreaCache();
+    r = planner.plan(*object, shelf, cfg);
+    contacts += r.stats.steps.contact_points;
+    setup += r.stats.steps.setup;
+  }
+  const double n = static_cast<double>(state.iterations());
+  int stable = 0;
+  for (const auto& c : r.candidates) stable += c.stable;
+  state.counters["area_tris"] = static_cast<double>(shelf.triangles.size());
+  state.counters["floor_points"] = r.stats.floor_points_total;
+  state.counters["stable"] = stable;
+  state.counters["first_stable_ms"] = r.stats.first_stable_ms;
+  state.counters["setup_ms"] = setup / n;
+  state.counters["contacts_ms"] = contacts / n;
+}
 void BM_DishRackWarm(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", false); }
 void BM_DishRackCold(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", true); }
 
@@ -143,6 +176,7 @@ BENCHMARK(BM_BooksStackCudaCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseR
 BENCHMARK(BM_BooksStackCudaPrincipalAxis)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DishRackWarm)->Arg(200)->Arg(500)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DishRackCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ShelfFromSideCold)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)

@@ -30,12 +30,18 @@ Mesh table();         // 1.0 x 0.8 m table top, 3 cm thick
 Mesh dishRack();      // tray 0.45 x 0.45 m with a grid of vertical pegs
 Mesh openBox();       // box with walls, open on top (0.3 x 0.25 x 0.12 m)
 Mesh binderStack();   // three binders stacked with offsets on a table top
+// A storage shelf unit 1.0 m wide (x), 0.4 m deep (y), 2.4 m tall: six 2 cm boards 0.45 m apart
+// (tops at z = 0.02, 0.47, ..., 2.27), side walls and a back wall at y = +0.2; open towards -y,
+// so it is approached from the side (d_vis = +y). Every face split into `subdivisions`^2 quads
+// (12: about 15k triangles, the size of a scanned shelf).
+Mesh shelfUnit(int subdivisions = 12);
 // Demo objects (mesh frame at their base centre, like a scan).
 Mesh mug();           // cylinder body with a handle, 0.08 m diameter
 Mesh plate();         // flat disc 0.24 m, 2 cm thick rim
 Mesh pen();           // thin cylinder 0.14 m long
 
-// Names accepted by byName(): table, dish_rack, open_box, binder_stack, mug, plate, pen, cube.
+// Names accepted by byName(): table, dish_rack, open_box, binder_stack, shelf, mug, plate, pen,
+// cube.
 Mesh byName(const std::string& name);
 std::vector<std::string> areaNames();
 std::vector<std::string> objectNames();

@@ -368,7 +368,17 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   int count = 0;
   double gap = kInf;
   const double lateral2 = 2.25 * area.mesh.sphere_radius * area.mesh.sphere_radius;
-  for (int k = g.start[cell]; k < g.start[cell + 1]; ++k) {
+  // A cell's spheres come highest first (buildHeightGrid): those higher than s_G by the collision
+  // distance or more cannot collide, so the walk starts below them, found by bisection (a shelf
+  // unit's column holds every board's spheres above the one the object rests on).
+  int first = g.start[cell], last = g.start[cell + 1];
+  const double reach_top = s_G.z + g.collision_distance;
+  while (first < last) {
+    const int mid = first + (last - first) / 2;
+    if (area.mesh.sphere_centres[g.items[mid]].z >= reach_top) first = mid + 1;
+    else last = mid;
+  }
+  for (int k = first; k < g.start[cell + 1]; ++k) {
     const int i = g.items[k];
     const V3 a = area.mesh.sphere_centres[i];
     // A cell's spheres come highest first (buildHeightGrid): below reach, so are the rest.

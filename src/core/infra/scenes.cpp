@@ -125,6 +125,42 @@ Mesh binderStack() {
   return b.build("binder_stack");
 }
 
+namespace {
+// A closed box whose faces are split into n x n quads (outward CCW), added to b.
+void splitBox(Builder& b, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int n) {
+  const Eigen::Vector3d d = hi - lo;
+  auto face = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    const int base = static_cast<int>(b.v.size());
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) b.v.push_back(o + u * (double(i) / n) + v * (double(j) / n));
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const int a = base + i * (n + 1) + j;
+        b.f.push_back({a, a + n + 1, a + n + 2, a + 1});  // u x v is the outward normal
+      }
+  };
+  const Eigen::Vector3d X(d.x(), 0, 0), Y(0, d.y(), 0), Z(0, 0, d.z());
+  face(lo, Y, X);           // -z
+  face(lo + Z, X, Y);       // +z
+  face(lo, X, Z);           // -y
+  face(lo + Y, Z, X);       // +y
+  face(lo, Z, Y);           // -x
+  face(lo + X, Y, Z);       // +x
+}
+}  // namespace
+
+Mesh shelfUnit(int n) {
+  Builder b;
+  for (int k = 0; k < 6; ++k) {
+    const double top = 0.02 + 0.45 * k;
+    splitBox(b, {-0.5, -0.2, top - 0.02}, {0.5, 0.2, top}, n);
+  }
+  splitBox(b, {-0.52, -0.2, 0.0}, {-0.5, 0.2, 2.4}, n);
+  splitBox(b, {0.5, -0.2, 0.0}, {0.52, 0.2, 2.4}, n);
+  splitBox(b, {-0.52, 0.2, 0.0}, {0.52, 0.22, 2.4}, n);
+  return b.build("shelf");
+}
+
 Mesh mug() {
   Builder b;
   const Mesh body = cylinder(0.04, 0.1, 24);
@@ -150,12 +186,13 @@ Mesh byName(const std::string& n) {
   if (n == "dish_rack") return dishRack();
   if (n == "open_box") return openBox();
   if (n == "binder_stack") return binderStack();
+  if (n == "shelf") return shelfUnit();
   if (n == "mug") return mug();
   if (n == "plate") return plate();
   if (n == "pen") return pen();
   if (n == "cube") return box(0.1, 0.1, 0.1, {0, 0, 0.05});
   throw std::invalid_argument("unknown built-in scene '" + n +
-                              "' (table, dish_rack, open_box, binder_stack, mug, plate, pen, cube)");
+                              "' (table, dish_rack, open_box, binder_stack, shelf, mug, plate, pen, cube)");
 }
 
 std::vector<std::string> areaNames() { return {"table", "dish_rack", "open_box", "binder_stack"}; }

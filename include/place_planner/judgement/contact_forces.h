@@ -57,10 +57,6 @@ struct PushResistance {
   std::array<double, kPushDirections> by_direction{};
   Eigen::Vector3d weakest = Eigen::Vector3d::UnitX();  // direction (G) of the smallest
 };
-// Contacts merged in cubic cells of `cell` (m): mean position and normal per cell. The force
-// model's cost grows with the contacts (8 columns each); merging keeps it bounded.
-std::vector<ContactPoint> mergeContacts(const std::vector<ContactPoint>& contacts, double cell);
-
 // Contacts within plane_tol (m) of one plane are taken as a planar support: their normals are
 // the plane's (the planner's contact normals blend the object's and the area's, and on a flat
 // area an object's rounded edge would tilt them into a shallow V that seems to resist a push).

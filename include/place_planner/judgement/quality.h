@@ -19,6 +19,16 @@ double polygonWidth(const std::vector<Eigen::Vector2d>& hull);
 double boundaryDistanceAlong(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& from,
                              const Eigen::Vector2d& dir);
 
+// Least-squares plane of 3D points: their centroid, the unit normal (least scatter; either
+// sign), the direction of the next least scatter, the farthest any point lies off the plane and
+// along that direction (a spread near 0: the points lie on a line).
+struct PlaneFit {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(), second = Eigen::Vector3d::UnitX();
+  double off = 0, spread = 0;
+};
+PlaneFit fitPlane(const std::vector<Eigen::Vector3d>& pts);
+
 // Q = 1 - d(c^_O, c^_Omega) / l^_Omega - s / (1 + s),  s = (h / sqrt(A(Omega)))^2 / 16.
 // The paper's second term d(c_O, Omega) / A(Omega) divides a length by an area; we use the
 // dimensionless height-to-footprint ratio h / sqrt(A) instead, squashed into [0, 1) so that

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
-#include <tuple>
+
+#include "place_planner/judgement/quality.h"
 
 namespace place_planner {
 namespace {
@@ -20,31 +20,19 @@ constexpr int kBisections = 7;
 // all lie within tol of it and span it; else unchanged.
 std::vector<ContactPoint> planarSupport(const std::vector<ContactPoint>& contacts, double tol) {
   if (contacts.size() < 3) return contacts;
-  Eigen::Vector3d c = Eigen::Vector3d::Zero(), nbar = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> pts;
+  Eigen::Vector3d nbar = Eigen::Vector3d::Zero();
   for (const ContactPoint& p : contacts) {
-    c += p.p_W;
+    pts.push_back(p.p_W);
     nbar += p.n_W;
   }
-  c /= static_cast<double>(contacts.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const ContactPoint& p : contacts) cov += (p.p_W - c) * (p.p_W - c).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-  Eigen::Vector3d n = es.eigenvectors().col(0);
-  if (n.dot(nbar) < 0) n = -n;
-  double off = 0, spread = 0;
-  for (const ContactPoint& p : contacts) {
-    off = std::max(off, std::abs((p.p_W - c).dot(n)));
-    spread = std::max(spread, std::abs((p.p_W - c).dot(es.eigenvectors().col(1))));
-  }
-  if (off > tol || spread <= tol) return contacts;
+  const PlaneFit fit = fitPlane(pts);
+  if (fit.off > tol || fit.spread <= tol) return contacts;
+  const Eigen::Vector3d n = fit.normal.dot(nbar) < 0 ? Eigen::Vector3d(-fit.normal) : fit.normal;
   std::vector<ContactPoint> out = contacts;
   for (ContactPoint& p : out) p.n_W = n;
   return out;
 }
-
-}  // namespace
-
-namespace {
 
 // Lawson-Hanson NNLS on a matrix of R rows, the passive set's least squares on a fixed-capacity
 // matrix (no heap allocation in the loop: the force model solves thousands per plan).
@@ -171,29 +159,6 @@ PushResistance pushResistance(const std::vector<ContactPoint>& contacts, const E
     }
   }
   return r;
-}
-
-std::vector<ContactPoint> mergeContacts(const std::vector<ContactPoint>& contacts, double cell) {
-  if (cell <= 0) return contacts;
-  struct Acc {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero(), n = Eigen::Vector3d::Zero();
-    int count = 0;
-  };
-  std::map<std::tuple<long, long, long>, Acc> cells;
-  for (const ContactPoint& c : contacts) {
-    Acc& a = cells[{std::lround(std::floor(c.p_W.x() / cell)), std::lround(std::floor(c.p_W.y() / cell)),
-                    std::lround(std::floor(c.p_W.z() / cell))}];
-    a.p += c.p_W;
-    a.n += c.n_W;
-    ++a.count;
-  }
-  std::vector<ContactPoint> out;
-  out.reserve(cells.size());
-  for (const auto& kv : cells) {
-    const double nn = kv.second.n.norm();
-    out.push_back({kv.second.p / kv.second.count, nn > 0 ? Eigen::Vector3d(kv.second.n / nn) : Eigen::Vector3d::UnitZ()});
-  }
-  return out;
 }
 
 bool equilibrium(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,

@@ -1,5 +1,6 @@
 #include "place_planner/judgement/quality.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,6 +11,23 @@ double cross2(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::V
   return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
 }
 }  // namespace
+
+PlaneFit fitPlane(const std::vector<Eigen::Vector3d>& pts) {
+  PlaneFit f;
+  if (pts.empty()) return f;
+  for (const auto& p : pts) f.centroid += p;
+  f.centroid /= static_cast<double>(pts.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : pts) cov += (p - f.centroid) * (p - f.centroid).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  f.normal = es.eigenvectors().col(0).normalized();
+  f.second = es.eigenvectors().col(1).normalized();
+  for (const auto& p : pts) {
+    f.off = std::max(f.off, std::abs((p - f.centroid).dot(f.normal)));
+    f.spread = std::max(f.spread, std::abs((p - f.centroid).dot(f.second)));
+  }
+  return f;
+}
 
 std::vector<Eigen::Vector2d> convexHull2d(std::vector<Eigen::Vector2d> p) {
   std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {

@@ -76,7 +76,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
       if (stats) ++stats->gripper_tilt_rejected;
       continue;
     }
-    Item it{i, l.stable, l.quality, rotationAngle(in.R_held_G, X.linear()), {}, false, 0, {}};
+    Item it{i, l.stable, l.quality, rotationAngle(in.R_held_G, X.linear()), {}, false, 0, {}, SupportKind::kSeen, {}, false};
     if (l.stable && in.completed_support) it.support = in.completed_support(i);
     if (config.rank_order == RankOrder::kLowest) it.preference = quantised((X * in.com_O).z(), 0.005);
     if (config.rank_order == RankOrder::kNearest) it.preference = quantised((X * in.com_O - near_G).norm(), 0.005);

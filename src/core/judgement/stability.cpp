@@ -6,28 +6,13 @@
 
 #include "place_planner/judgement/contact_forces.h"
 #include "place_planner/judgement/quality.h"
+#include "place_planner/search/contact_points.h"
 
 namespace place_planner {
 namespace {
 
 const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();  // -d_g in G
 
-// Least-squares plane of points: their centroid and the eigen decomposition of their scatter
-// (smallest eigenvector first: the normal).
-struct PlaneFit {
-  Eigen::Vector3d centroid;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
-};
-PlaneFit fitPlane(const std::vector<Eigen::Vector3d>& pts) {
-  PlaneFit f;
-  f.centroid = Eigen::Vector3d::Zero();
-  for (const auto& p : pts) f.centroid += p;
-  f.centroid /= static_cast<double>(pts.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const auto& p : pts) cov += (p - f.centroid) * (p - f.centroid).transpose();
-  f.eigen.compute(cov);
-  return f;
-}
 
 // 2D analysis of a support polygon in the plane through `origin` with normal `n` (unit),
 // centre of mass projected along gravity (-z).
@@ -134,14 +119,14 @@ Eigen::Vector3d farthest(const std::vector<ContactPoint>& c, const Eigen::Vector
   return best;
 }
 
-// The contact forces (contact_forces.h) on the contacts merged in cells of an eighth of their
-// extent (at least the contact tolerance): a few dozen at most, so the NNLS stays small whatever
+// The contact forces (contact_forces.h) on the contacts merged (reduceContacts) in cells of an
+// eighth of their extent (at least the contact tolerance): a few dozen at most, so the NNLS stays small whatever
 // the sphere model's density.
 ContactForces forceModel(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                          const StabilityParams& prm) {
   double extent = 0;
   for (const ContactPoint& p : contacts) extent = std::max(extent, (p.p_W - contacts.front().p_W).norm());
-  return ContactForces(mergeContacts(contacts, std::max(prm.tol, extent / 8)), com,
+  return ContactForces(reduceContacts(contacts, std::max(prm.tol, extent / 8)), com,
                        ForceModelParams{prm.friction, 8, prm.max_load});
 }
 
@@ -174,15 +159,8 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   for (const auto& p : contacts) pts.push_back(p.p_W);
   const PlaneFit fit = fitPlane(pts);
   const Eigen::Vector3d& c = fit.centroid;
-  const auto& es = fit.eigen;
-  Eigen::Vector3d n = es.eigenvectors().col(0).normalized();
-  if (n.dot(kUp) < 0) n = -n;
-  double off = 0, spread2 = 0;
-  const Eigen::Vector3d second = es.eigenvectors().col(1).normalized();
-  for (const auto& p : pts) {
-    off = std::max(off, std::abs((p - c).dot(n)));
-    spread2 = std::max(spread2, std::abs((p - c).dot(second)));
-  }
+  const Eigen::Vector3d n = fit.normal.dot(kUp) < 0 ? Eigen::Vector3d(-fit.normal) : fit.normal;
+  const double off = fit.off, spread2 = fit.spread;
   // Planar: on one plane and spanning it (contacts on a line lie on every plane through it).
   // The contacts must push the object up: their mean normal (pointing at the object) against
   // gravity. Contacts from above (an object pressed under a table) never support it.

@@ -45,6 +45,34 @@ TEST(ContactForces, LadderHoldsExactlyAboveTheFrictionAngle) {
   EXPECT_FALSE(equilibrium(c, com, kGravity, 0.7));
 }
 
+TEST(ContactForces, SlippingLadderKicksItsFootAwayFromTheWall) {
+  // mu 0.2: the ladder holds from 67.4 degrees. Below, wide cones would hold it, so friction
+  // alone fails: it slips, its foot away from the wall (-x), and the stability's local step
+  // slides it that way, lifted straight up first.
+  const double mu = 0.2;
+  Eigen::Vector3d com;
+  const ForceModelParams prm{mu, 8, 3.0};
+  for (double theta_deg : {50.0, 60.0, 65.0}) {
+    const auto c = ladder(theta_deg * M_PI / 180.0, 0.4, &com);
+    const Eigen::Vector3d d = slipDirection(c, com, prm);
+    EXPECT_LT(d.x(), -0.99) << theta_deg;
+    EXPECT_NEAR(d.z(), 0.0, 1e-12);
+    StabilityParams sp;
+    sp.friction = mu;
+    const Stability s = evaluateStability(c, com, sp);
+    EXPECT_FALSE(s.stable);
+    EXPECT_TRUE(s.slips) << theta_deg;
+    EXPECT_EQ(s.failure, Failure::kSlide);
+    EXPECT_LT(s.d_f.x(), -0.99);
+  }
+  // Above the critical angle it holds: no slip.
+  auto c = ladder(72.0 * M_PI / 180.0, 0.4, &com);
+  EXPECT_EQ(slipDirection(c, com, prm).norm(), 0.0);
+  // Without the wall no friction holds it (it falls, it does not slip).
+  c.erase(std::remove_if(c.begin(), c.end(), [](const ContactPoint& p) { return p.n_W.z() < 0.5; }), c.end());
+  EXPECT_EQ(slipDirection(c, com, prm).norm(), 0.0);
+}
+
 // A 4 cm box whose lower edges touch two walls at `wall_deg` from the horizontal (a V-groove).
 std::vector<ContactPoint> vGroove(double wall_deg, bool both_walls) {
   const double a = wall_deg * M_PI / 180.0;

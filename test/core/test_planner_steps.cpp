@@ -12,6 +12,8 @@
 #include "place_planner/judgement/quality.h"
 #include "place_planner/judgement/contact_forces.h"
 #include "place_planner/judgement/stability.h"
+#include "place_planner/judgement/penetration.h"
+#include "place_planner/infra/scenes.h"
 #include "place_planner/search/tilt_axis.h"
 #include "test_helpers.h"
 
@@ -174,6 +176,17 @@ TEST(TiltAxis, LayoutsAndAxes) {
   EXPECT_NEAR(std::abs(a.d_A.dot(Eigen::Vector3d(1, 1, 0).normalized())), 1.0, 1e-9);
   line.push_back({{0.1, 0, 0}, {0, 0, 1}});
   EXPECT_EQ(tiltAxis(line, com, Eigen::Vector3d(1, 0, 0), dg, 1e-3, 0).layout, ContactLayout::kIndependent);
+  // A short line along x with the centre of mass beyond its end along it (a pen's foot in a
+  // cup's corner): it tips over that end about y, not about the line.
+  const std::vector<ContactPoint> foot = {{{0, 0, 0}, {0, 0, 1}}, {{0.01, 0, 0}, {-1, 0, 0}}, {{0.02, 0, 0}, {0, 0, 1}}};
+  a = tiltAxis(foot, Eigen::Vector3d(0.08, 0.001, 0.05), Eigen::Vector3d(1, 0, 0), dg, 1e-3, 0);
+  EXPECT_EQ(a.layout, ContactLayout::kSingle);
+  EXPECT_NEAR(std::abs(a.d_A.y()), 1.0, 1e-3);
+  EXPECT_NEAR(a.s_A.x(), 0.02, 1e-3);
+  // The centre of mass across the same line: it turns about the line.
+  a = tiltAxis(foot, Eigen::Vector3d(0.01, 0.05, 0.05), Eigen::Vector3d(1, 0, 0), dg, 1e-3, 0);
+  EXPECT_EQ(a.layout, ContactLayout::kCollinear);
+  EXPECT_NEAR(std::abs(a.d_A.x()), 1.0, 0.05);
 }
 
 TEST(Stability, SquareFootprintQualityAndFailure) {
@@ -388,4 +401,21 @@ TEST(FeatureEdges, OrientationPerPiece) {
   const Mesh both = scenes::merge({l_prism, big_box});
   // 17 of the prism's 18 edges and the box's 12.
   EXPECT_EQ(featureEdges(both).size(), 17u + 12u);
+}
+
+// The penetration guard measures depth along the surface's normal: a vertex 1 mm inside a
+// 60 degree slope lies 2 mm below it straight up, and is 1 mm deep.
+TEST(Penetration, DepthAlongTheSurfaceNormal) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(60 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Mesh slab = transformed(scenes::box(0.2, 0.2, 0.02), R, Eigen::Vector3d::Zero());
+  const Eigen::Vector3d n = R * Eigen::Vector3d::UnitZ();  // the slope's outward normal
+  const AreaModel am = buildAreaModel(slab, {0, 0, -1}, 0.002, 0.0035, 0.0035);
+  const ObjectModel om = buildObjectModel(scenes::box(0.004, 0.004, 0.004), 0.0005);
+  for (double inside : {0.0005, 0.001, 0.002}) {
+    // The cube's corner deepest along -n: 2 mm (|n_x| + |n_y| + |n_z|) from its centre.
+    const double reach = 0.002 * (n.cwiseAbs().sum());
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.translation() = (0.01 - inside + reach) * n;
+    EXPECT_NEAR(penetrationDepth(om, am, toRigid(X)), inside, 1e-4) << inside;
+  }
 }

@@ -43,10 +43,13 @@ class ContactForces {
   // 0 when gravity alone is not balanced.
   double pushResistance(const Eigen::Vector3d& d, double cap = 1.0) const;
   bool empty() const { return A_.cols() == 0; }
+  // The force on contact i (G, weights) of the cone-edge weights `forces` (balances()).
+  Eigen::Vector3d contactForce(const Eigen::VectorXd& forces, size_t i) const;
 
  private:
   Eigen::Matrix<double, 7, Eigen::Dynamic> A_;  // rows: force (3), torque / L (3), load weight (1)
   double max_load_;
+  int edges_ = 8;
 };
 
 // Push resistance over kPushDirections horizontal directions of G, k * 45 degrees from +x.
@@ -62,6 +65,14 @@ struct PushResistance {
 // area an object's rounded edge would tilt them into a shallow V that seems to resist a push).
 PushResistance pushResistance(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                               const ForceModelParams& params, double cap = 1.0, double plane_tol = 0.0);
+
+// Slipping: when gravity is not balanced with the friction of `params` but is with friction
+// mu_hold (wide cones: the geometry would hold the object, its friction does not), the
+// horizontal unit direction (G) it slips in: against the friction the wide cones use beyond
+// mu, summed over the contacts (a plate leaning on a peg, its foot kicking out). Zero when it
+// does not slip so (balanced, or not even with mu_hold: it tips or falls).
+Eigen::Vector3d slipDirection(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                              const ForceModelParams& params, double mu_hold = 1.0);
 
 // One-call form of ContactForces::balances (kept for the tests of the earlier API): the default
 // 8-edge cone, max_load as given.

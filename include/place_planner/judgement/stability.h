@@ -29,6 +29,9 @@ struct Stability {
   double tipping_angle = 0.0;                       // rad, tilt needed to tip over (planar)
   Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();  // of P, against gravity
   Failure failure = Failure::kTip;
+  // Only friction fails (slipDirection, contact_forces.h): d_f is the horizontal slip. The tree
+  // slides it before any turn: a marker's foot in a cup, a plate's on a rack's floor.
+  bool slips = false;
   Eigen::Vector3d d_f = Eigen::Vector3d::Zero();    // failure direction (unit)
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  // farthest contact of Omega along d_f
   // Tipping: the edge of Omega that the centre of mass lies beyond (or is nearest to), as a

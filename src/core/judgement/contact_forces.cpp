@@ -97,8 +97,8 @@ double nnlsRows(const Eigen::Ref<const Eigen::Matrix<double, R, Eigen::Dynamic>>
 
 ContactForces::ContactForces(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                              const ForceModelParams& prm)
-    : max_load_(prm.max_load) {
-  const int edges = std::max(3, prm.cone_edges);
+    : max_load_(prm.max_load), edges_(std::max(3, prm.cone_edges)) {
+  const int edges = edges_;
   // Torques in units of force: divided by the contacts' reach from the centre of mass.
   double L = 1e-3;
   for (const ContactPoint& c : contacts) L = std::max(L, (c.p_W - com).norm());
@@ -129,6 +129,38 @@ bool ContactForces::balances(const Eigen::Vector3d& f_ext, Eigen::VectorXd* forc
   const double residual = (A_.topRows(6) * x - b.head<6>()).norm();
   const double load = A_.row(6).dot(x) / kLoadWeight;  // total normal force
   return residual < 1e-4 * f_ext.norm() && load <= max_load_ * f_ext.norm();
+}
+
+Eigen::Vector3d ContactForces::contactForce(const Eigen::VectorXd& forces, size_t i) const {
+  Eigen::Vector3d f = Eigen::Vector3d::Zero();
+  for (int k = 0; k < edges_; ++k) {
+    const long col = edges_ * static_cast<long>(i) + k;
+    if (col < forces.size()) f += forces[col] * A_.block<3, 1>(0, col);
+  }
+  return f;
+}
+
+Eigen::Vector3d slipDirection(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                              const ForceModelParams& params, double mu_hold) {
+  const Eigen::Vector3d g(0, 0, -1);
+  if (ContactForces(contacts, com, params).balances(g)) return Eigen::Vector3d::Zero();
+  ForceModelParams wide = params;
+  wide.friction = std::max(mu_hold, params.friction);
+  const ContactForces held(contacts, com, wide);
+  Eigen::VectorXd x;
+  if (!held.balances(g, &x)) return Eigen::Vector3d::Zero();
+  // Friction points against the motion it stops: the object slips against the excess.
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < contacts.size(); ++i) {
+    const Eigen::Vector3d n = contacts[i].n_W.normalized();
+    const Eigen::Vector3d f = held.contactForce(x, i);
+    const double fn = f.dot(n);
+    const Eigen::Vector3d t = f - fn * n;
+    const double tn = t.norm();
+    if (tn > params.friction * std::max(fn, 0.0) + 1e-9) d -= (1.0 - params.friction * std::max(fn, 0.0) / tn) * t;
+  }
+  d.z() = 0;
+  return d.norm() > 1e-6 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::Zero();
 }
 
 double ContactForces::pushResistance(const Eigen::Vector3d& d, double cap) const {

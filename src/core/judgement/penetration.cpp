@@ -29,9 +29,15 @@ double penetrationDepth(const ObjectModel& object, const AreaModel& area, const 
           hit[vi] = k;
         }
       });
+  // The depth below the surface is along its normal: the vertical hit distance times the
+  // normal's vertical part (the same on a floor; on a steep wall, a vertex a millimetre inside
+  // lies far below the wall's surface straight above it).
   double deepest = 0;
-  for (size_t vi = 0; vi < hit.size(); ++vi)
-    if (hit[vi] >= 0 && dot(area.triangle_normals[hit[vi]], up) > 0) deepest = std::max(deepest, nearest[vi]);
+  for (size_t vi = 0; vi < hit.size(); ++vi) {
+    if (hit[vi] < 0) continue;
+    const double up_part = dot(area.triangle_normals[hit[vi]], up);
+    if (up_part > 0) deepest = std::max(deepest, nearest[vi] * up_part / std::max(1e-12, norm(area.triangle_normals[hit[vi]])));
+  }
   return deepest;
 }
 

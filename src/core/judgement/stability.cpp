@@ -130,6 +130,17 @@ ContactForces forceModel(const std::vector<ContactPoint>& contacts, const Eigen:
                        ForceModelParams{prm.friction, 8, prm.max_load});
 }
 
+// Where only friction fails (slipDirection: wide cones would hold it), the horizontal direction
+// the object slips in; the local optimisation slides it there (a plate's foot against the peg
+// behind it), where the paper's tip direction would turn it over.
+Eigen::Vector3d slipOf(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                       const StabilityParams& prm) {
+  double extent = 0;
+  for (const ContactPoint& p : contacts) extent = std::max(extent, (p.p_W - contacts.front().p_W).norm());
+  return slipDirection(reduceContacts(contacts, std::max(prm.tol, extent / 8)), com,
+                       ForceModelParams{prm.friction, 8, prm.max_load});
+}
+
 // The contact forces balance gravity, and gravity tilted by half the friction angle towards each
 // of the 4 horizontal axis directions of G (a margin against sliding and tipping).
 bool balancedWithMargin(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
@@ -197,8 +208,14 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
       r.balanced = r.balanced || forces_balance;
       r.friction_ok = r.friction_ok || r.stable;
     }
+    Eigen::Vector3d slip = Eigen::Vector3d::Zero();
+    if (!faces_on_plane && !r.balanced) slip = slipOf(contacts, com, prm);
     if (r.stable) {
       r.failure = Failure::kNone;
+    } else if (slip.norm() > 0) {
+      r.failure = Failure::kSlide;
+      r.slips = true;
+      r.d_f = slip;
     } else if (!r.friction_ok) {
       r.failure = Failure::kSlide;
       const Eigen::Vector3d down = -kUp - (-kUp).dot(n) * n;  // d_g projected onto P
@@ -245,9 +262,14 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   const bool stable = balancedWithMargin(contacts, com, prm, &r.balanced);
   r.friction_ok = stable;
   r.stable = stable;
+  const Eigen::Vector3d slip = stable || r.balanced ? Eigen::Vector3d::Zero() : slipOf(contacts, com, prm);
   if (stable) {
     r.failure = Failure::kNone;
     r.quality = std::max(r.quality, 0.3);  // Q is a ranking here; equilibrium decided stability
+  } else if (slip.norm() > 0) {
+    r.failure = Failure::kSlide;
+    r.slips = true;
+    r.d_f = slip;
   } else {
     r.failure = Failure::kTip;
     r.d_f = ref.valid ? tipDirection(ref) : Eigen::Vector3d::UnitX();

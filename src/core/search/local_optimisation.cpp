@@ -8,7 +8,8 @@ LocalStep localOptimisationStep(const Stability& s, const Eigen::Vector3d& com, 
   const Eigen::Vector3d d_g = -Eigen::Vector3d::UnitZ();
   if (s.failure == Failure::kSlide) {
     step.kind = LocalStep::kSlide;
-    step.lift = lift * s.plane_normal;
+    // A slip found by the contact forces is horizontal: lifted straight up, clear of the floor.
+    step.lift = lift * (std::abs(s.d_f.z()) < 1e-9 ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : s.plane_normal);
     step.slide = s.d_f;
     return step;
   }

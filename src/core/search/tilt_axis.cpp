@@ -50,6 +50,18 @@ TiltAxis tiltAxis(const std::vector<ContactPoint>& contacts, const Eigen::Vector
   if (off <= std::max(tol, kLineAspect * (hi - lo))) {
     a.layout = ContactLayout::kCollinear;
     a.d_A = dir;
+    // The centre of mass beyond an end of the line, along it (a pen's foot in a cup's corner,
+    // the cluster running towards its lean): it tips over that end, about the horizontal axis
+    // across its offset, as from one point.
+    const Eigen::Vector3d off_h = (com - c) - (com - c).dot(d_g) * d_g;
+    const Eigen::Vector3d dir_h = dir - dir.dot(d_g) * d_g;
+    const double along = off_h.dot(dir_h.normalized());
+    if (dir_h.norm() > 0.5 && off_h.norm() > tol && std::abs(along) > std::cos(M_PI / 4) * off_h.norm() &&
+        std::abs(along) > std::max(-lo, hi) * dir_h.norm() + tol) {
+      a.layout = ContactLayout::kSingle;
+      a.s_A = c + (along > 0 ? hi : lo) * dir;
+      a.d_A = off_h.cross(d_g).normalized();
+    }
     return a;
   }
   a.layout = ContactLayout::kIndependent;

@@ -62,9 +62,13 @@ constexpr double kWedgeTilt = 52.0 * M_PI / 180.0;
 constexpr double kFallDrop = 0.01;
 constexpr double kFallProbe = 0.015;
 
-// The kWedgeTilt test on a rocked pose's contacts.
+// The kWedgeTilt test on a rocked pose's contacts. A pose that also stands on a floor (a contact
+// within kFloorTilt of vertical: a pen's foot in a cup, leaning on the rim) does not hang.
+constexpr double kFloorTilt = 25.0 * M_PI / 180.0;
 bool hangsBetweenEdges(const std::vector<ContactPoint>& contacts) {
   const double c = std::cos(kWedgeTilt);
+  for (const ContactPoint& p : contacts)
+    if (p.n_W.z() >= std::cos(kFloorTilt)) return false;
   for (size_t a = 0; a < contacts.size(); ++a) {
     const Eigen::Vector3d& na = contacts[a].n_W;
     if (na.z() > c) continue;
@@ -239,9 +243,9 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     n.tipping_angle = s.tipping_angle;
     n.supported = supported;
     if (kTrace)
-      std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d tip %.1f deg Q %.3f\n",
+      std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d tip %.1f deg Q %.3f slips %d d_f %.2f %.2f %.2f\n",
                    n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable,
-                   s.tipping_angle * 180 / M_PI, s.quality);
+                   s.tipping_angle * 180 / M_PI, s.quality, s.slips, s.d_f.x(), s.d_f.y(), s.d_f.z());
     if (n.contacts.empty()) continue;
     // One contact or a line of contacts never holds an object as a polygon (a ball rolls, a
     // cylinder on its side turns about its line): tilt (Section V-C) about the point or the line.
@@ -278,31 +282,8 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     }
     const bool falls = overhang && n.overhang;
     n.overhang = overhang;
-    if (falls) {
-      TreeLeaf l{n.X_GO, n.root, false, true, supported, s.quality, s.tipping_angle, n.contacts, n.path};
-      l.fell = true;
-      leaves.push_back(std::move(l));
-    } else if (line && rolls && can_turn) {
-      n.d_A = axis.d_A;
-      rolling_.push_back(std::move(n));
-    } else if (line && can_turn) {
-      n.s_A = axis.s_A;
-      n.d_A = axis.d_A;
-      n.both_directions = true;
-      n.local_rotation = false;
-      rotating_.push_back(std::move(n));
-    } else if (line) {
-      leaf(false, false);  // still tilting when the tree was cut
-    } else if ((s.stable || s.balanced) && ctx_.rock_settle && n.rocks < kMaxRocks &&
-               !flatSupport(s, n.contacts)) {
-      // Held, or balanced by the contact forces without their margin (propped a few degrees
-      // off on domes or a rim): the rock settle finds whether it sinks to a lower pose.
-      n.held = s.stable;
-      rocking_.push_back(std::move(n));
-    } else if (s.stable) {
-      leaf(true, true);
-    } else if (n.opt < ctx_.max_opt) {
-      // Local optimisation (Section VI): slide down the slope, or tip into the failure direction.
+    // Local optimisation (Section VI): slide down the slope, or tip into the failure direction.
+    auto optimise = [&] {
       const auto tl = Clock::now();
       const LocalStep step = localOptimisationStep(s, com, cd);
       addTime(ctx_.times ? &ctx_.times->local_optimisation : nullptr, tl);
@@ -323,6 +304,34 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
       } else {
         leaf(false, true);
       }
+    };
+    if (falls) {
+      TreeLeaf l{n.X_GO, n.root, false, true, supported, s.quality, s.tipping_angle, n.contacts, n.path};
+      l.fell = true;
+      leaves.push_back(std::move(l));
+    } else if (s.slips && n.opt < ctx_.max_opt) {
+      optimise();  // friction alone fails: it slides before it turns (even on a line of contacts)
+    } else if (line && rolls && can_turn) {
+      n.d_A = axis.d_A;
+      rolling_.push_back(std::move(n));
+    } else if (line && can_turn) {
+      n.s_A = axis.s_A;
+      n.d_A = axis.d_A;
+      n.both_directions = true;
+      n.local_rotation = false;
+      rotating_.push_back(std::move(n));
+    } else if (line) {
+      leaf(false, false);  // still tilting when the tree was cut
+    } else if ((s.stable || s.balanced) && ctx_.rock_settle && n.rocks < kMaxRocks &&
+               !flatSupport(s, n.contacts)) {
+      // Held, or balanced by the contact forces without their margin (propped a few degrees
+      // off on domes or a rim): the rock settle finds whether it sinks to a lower pose.
+      n.held = s.stable;
+      rocking_.push_back(std::move(n));
+    } else if (s.stable) {
+      leaf(true, true);
+    } else if (n.opt < ctx_.max_opt) {
+      optimise();
     } else {
       leaf(false, true);
     }

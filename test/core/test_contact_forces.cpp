@@ -73,6 +73,36 @@ TEST(ContactForces, SlippingLadderKicksItsFootAwayFromTheWall) {
   EXPECT_EQ(slipDirection(c, com, prm).norm(), 0.0);
 }
 
+TEST(ContactForces, RingHangsOnAPegWithItsCentreOfMassBelow) {
+  // A ring on a horizontal peg (along y): two contacts on the peg's top, across the ring's
+  // thickness, pushing up. Its centre of mass 3 cm below.
+  StabilityParams sp;  // mu 0.2
+  auto ring = [](double slope_deg) {
+    // The peg sloping down towards +y: its top's normal leans towards +y.
+    const double a = slope_deg * M_PI / 180;
+    const Eigen::Vector3d n(0, std::sin(a), std::cos(a));
+    return std::vector<ContactPoint>{{{0, -0.003, 0}, n}, {{0, 0.003, 0}, n}};
+  };
+  const Stability below = evaluateStability(ring(0), Eigen::Vector3d(0, 0, -0.03), sp);
+  EXPECT_TRUE(below.hanging);
+  EXPECT_TRUE(below.stable) << "a ring straight below a horizontal peg hangs";
+  EXPECT_GT(below.tipping_angle, 0.0);
+  // 1 cm to the side: gravity turns it about the peg; not in equilibrium (it swings).
+  const Stability aside = evaluateStability(ring(0), Eigen::Vector3d(0.01, 0, -0.03), sp);
+  EXPECT_TRUE(aside.hanging);
+  EXPECT_FALSE(aside.balanced);
+  EXPECT_FALSE(aside.stable);
+  EXPECT_GT(aside.d_f.x(), 0.9) << "it swings towards its centre of mass";
+  // A peg sloping down 5 degrees holds it (with the half friction angle's margin, 5.7 degrees,
+  // under atan 0.2 = 11.3); past atan mu it slides off.
+  EXPECT_TRUE(evaluateStability(ring(5), Eigen::Vector3d(0, 0, -0.03), sp).stable);
+  for (double slope : {12.0, 20.0}) {
+    const Stability off = evaluateStability(ring(slope), Eigen::Vector3d(0, 0, -0.03), sp);
+    EXPECT_FALSE(off.balanced) << slope;
+    EXPECT_FALSE(off.stable) << slope;
+  }
+}
+
 // A 4 cm box whose lower edges touch two walls at `wall_deg` from the horizontal (a V-groove).
 std::vector<ContactPoint> vGroove(double wall_deg, bool both_walls) {
   const double a = wall_deg * M_PI / 180.0;

@@ -390,6 +390,52 @@ TEST(Search, LeaningBoardSlidesToTheStopBehindItsFoot) {
   EXPECT_NEAR(low, 0.0, 0.004) << "its foot is not on the floor";
 }
 
+// A ring (torus, axis along y) dropped over a horizontal square peg with its centre 1 cm to
+// the side: it lands on the peg's near corner, swings about it (the exact rotation to where its
+// centre of mass is lowest, or to the next contact) and hangs with its centre of mass straight
+// below the peg, held by the contact forces (beyond the paper, which cannot hang objects).
+TEST(Search, RingSwingsToHangBelowAPeg) {
+  const double R = 0.03, r = 0.004;
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::vector<int>> f;
+  const int nu = 48, nv = 12;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const double u = 2 * M_PI * i / nu, w = 2 * M_PI * j / nv;
+      v.emplace_back((R + r * std::cos(w)) * std::cos(u), r * std::sin(w), (R + r * std::cos(w)) * std::sin(u));
+    }
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const int a = i * nv + j, b = ((i + 1) % nu) * nv + j, c = ((i + 1) % nu) * nv + (j + 1) % nv,
+                d = i * nv + (j + 1) % nv;
+      f.push_back({a, d, c, b});
+    }
+  const Mesh torus = buildMesh(v, f, "ring");
+  Mesh peg = scenes::box(0.008, 0.12, 0.008, {0, 0, 0.2});  // top at z = 0.204
+  TreeScene scene(torus, peg, 0.0008, 0.0012, 0.2);
+  scene.ctx.rock_settle = true;
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(0.01, 0, 0.208 - (R - r));  // inner top 4 mm over the peg
+  TreeStepper stepper(scene.ctx);
+  stepper.addRoot(toRigid(X), 0, scene.om.com, v3(0, 0, -1), 0.05);
+  std::vector<TreeLeaf> leaves;
+  for (int i = 0; i < 200 && !stepper.empty(); ++i) stepper.step(leaves);
+  ASSERT_EQ(leaves.size(), 1u);
+  const TreeLeaf& l = leaves.front();
+  const Eigen::Vector3d com = toEigen(apply(l.X_GO, scene.om.com));
+  ASSERT_TRUE(l.stable) << "the ring does not hang on the peg";
+  EXPECT_LE(std::abs(com.x()), 0.005) << "its centre of mass is not below the peg";
+  EXPECT_LT(com.z(), 0.2 - 0.02) << "not hanging";
+  for (const ContactPoint& c : l.contacts) EXPECT_GT(c.p_W.z(), 0.195) << "a contact below the peg's top";
+  // Without the peg's top under it (the ring released beside the peg) nothing holds it.
+  X.translation().x() = 0.05;
+  TreeStepper beside(scene.ctx);
+  beside.addRoot(toRigid(X), 1, scene.om.com, v3(0, 0, -1), 0.05);
+  leaves.clear();
+  for (int i = 0; i < 200 && !beside.empty(); ++i) beside.step(leaves);
+  for (const TreeLeaf& b : leaves) EXPECT_FALSE(b.stable);
+}
+
 TEST(Robustness, MugTiltedOnPegTopsRocksBackUpright) {
   PP_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");

@@ -32,6 +32,10 @@ struct Stability {
   // Only friction fails (slipDirection, contact_forces.h): d_f is the horizontal slip. The tree
   // slides it before any turn: a marker's foot in a cup, a plate's on a rack's floor.
   bool slips = false;
+  // Every contact lies above the centre of mass: the object hangs (a ring on a peg, a mug by
+  // its handle). Stable when the forces balance gravity and friction holds gravity tilted by
+  // half the friction angle; a tilt's torque is taken by a swing (the tree's swing settle).
+  bool hanging = false;
   Eigen::Vector3d d_f = Eigen::Vector3d::Zero();    // failure direction (unit)
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  // farthest contact of Omega along d_f
   // Tipping: the edge of Omega that the centre of mass lies beyond (or is nearest to), as a

@@ -343,6 +343,10 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
 }
 
 // ------------------------------------------------------------------ contact kernel (V-B)
+// An area normal and the object's inward normal agree when their cosine exceeds this (surfaces
+// facing each other within about 72 degrees).
+constexpr double kAgree = 0.3;
+
 struct SphereContact {
   V3 p;       // p_c: mean of the colliding area spheres
   V3 n;       // contact normal, pointing at the object
@@ -351,9 +355,12 @@ struct SphereContact {
 
 // Contact of one object sphere (centre s_G, outward normal n_G, both posed) with the area via
 // the height grid: early out on the cell's maximum height, else the arithmetic mean of the
-// colliding area spheres. The normal blends the area's normals and the object's inward normal,
-// each turned to point at the object's centre of mass (com_G): the paper's d_c = s - p_c is
-// ill-defined when the two surfaces are coplanar, as in every face-on-face contact.
+// colliding area spheres. The normal blends the area's normals and the object's inward normal:
+// the paper's d_c = s - p_c is ill-defined when the two surfaces are coplanar, as in every
+// face-on-face contact. Each is turned to point at the object's centre of mass (com_G), except
+// under a contact above the centre of mass where an area normal and the object's inward normal
+// agree (both meshes wound outward there): a ring hanging on a peg has its centre of mass
+// across the peg from the contact, and the peg pushes it up.
 PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G) {
   SphereContact out{v3(0, 0, 0), v3(0, 0, 1), 0};
   const GridView& g = area.grid;
@@ -385,7 +392,8 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
     if (a.z <= s_G.z - g.collision_distance) break;
     if (norm2(a - s_G) >= cd2) continue;
     V3 na = area.mesh.sphere_normals[i];
-    if (dot(na, com_G - a) < 0) na = -na;
+    const bool hangs_here = com_G.z < a.z && dot(na, n_G) < -kAgree;
+    if (!hangs_here && dot(na, com_G - a) < 0) na = -na;
     sum = sum + a;
     nsum = nsum + na;
     ++count;
@@ -402,10 +410,12 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   if (count == 0 || gap > g.contact_gap) return out;
   out.p = (1.0 / count) * sum;
   V3 no = -n_G;
-  if (dot(no, com_G - s_G) < 0) no = -no;
-  V3 n = (1.0 / count) * nsum + no;
+  const V3 nmean = (1.0 / count) * nsum;
+  const bool agree = com_G.z < out.p.z && dot(nmean, no) > kAgree * sqrt(norm2(nmean));
+  if (!agree && dot(no, com_G - s_G) < 0) no = -no;
+  V3 n = nmean + no;
   if (norm2(n) < 1e-12) n = s_G - out.p;
-  if (dot(n, com_G - out.p) < 0) n = -n;
+  if (!agree && dot(n, com_G - out.p) < 0) n = -n;
   out.n = normalized(n);
   out.valid = 1;
   return out;

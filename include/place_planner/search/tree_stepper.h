@@ -39,6 +39,7 @@ struct TreeNode {
   int rocks = 0;          // rock settle steps taken (rockStep)
   bool held = false;      // its last stability test held it with margin (rocked when only balanced)
   bool overhang = false;  // its last pose was past its support over a drop (see fall_tip)
+  bool hanging = false;   // its last stability test found every contact above the centre of mass
 };
 
 struct TreeLeaf {

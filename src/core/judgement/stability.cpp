@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "place_planner/judgement/contact_forces.h"
 #include "place_planner/judgement/quality.h"
@@ -141,6 +142,51 @@ Eigen::Vector3d slipOf(const std::vector<ContactPoint>& contacts, const Eigen::V
                        ForceModelParams{prm.friction, 8, prm.max_load});
 }
 
+// Hanging: the forces balance gravity (the centre of mass straight below the support), and
+// friction holds gravity tilted by half the friction angle towards each of the 4 horizontal axis
+// directions (force rows only: the tilt's torque swings the object to a new rest, it does not
+// make it fall). A ring on a peg sloping down past atan mu slides off.
+Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                           const StabilityParams& prm) {
+  Stability r;
+  r.hanging = true;
+  const ContactForces forces = forceModel(contacts, com, prm);
+  r.balanced = forces.balances(-kUp);
+  bool holds = r.balanced;
+  const double tilt = 0.5 * std::atan(prm.friction);
+  for (int k = 0; k < 4 && holds; ++k) {
+    const double phi = k * M_PI / 2;
+    holds = forces.balancesForce(Eigen::Vector3d(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi), -std::cos(tilt)));
+  }
+  r.stable = holds;
+  r.friction_ok = holds;
+  r.com_inside = r.balanced;
+  // Q: how far below its support the centre of mass hangs, against the support's spread (a
+  // deep pendulum swings back from a push; one just under a wide support barely).
+  double top = -std::numeric_limits<double>::infinity(), reach = 1e-9;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : contacts) c += p.p_W;
+  c /= static_cast<double>(contacts.size());
+  for (const auto& p : contacts) {
+    top = std::max(top, p.p_W.z());
+    reach = std::max(reach, (p.p_W - c).norm());
+  }
+  const Eigen::Vector3d off = com - c;
+  // Its margin: the swing the support allows before the centre of mass comes level with it.
+  r.tipping_angle = holds ? std::atan2(-off.z(), reach) : 0.0;
+  r.quality = holds ? std::max(0.3, 1.0 - std::hypot(off.x(), off.y()) / reach) : -1.0;
+  if (holds) {
+    r.failure = Failure::kNone;
+  } else {
+    // It swings: towards its centre of mass's side, about the support.
+    r.failure = Failure::kTip;
+    const Eigen::Vector3d h(off.x(), off.y(), 0);
+    r.d_f = h.norm() > 1e-9 ? Eigen::Vector3d(h.normalized()) : Eigen::Vector3d::UnitX();
+  }
+  r.pivot = c;
+  return r;
+}
+
 // The contact forces balance gravity, and gravity tilted by half the friction angle towards each
 // of the 4 horizontal axis directions of G (a margin against sliding and tipping).
 bool balancedWithMargin(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
@@ -165,6 +211,17 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   Stability r;
   if (contacts.empty()) return r;
   const double cone = std::atan(prm.friction);
+  // ---------------------------------------------------------------- hanging (beyond the paper,
+  // whose heuristic needs contacts beneath the centre of mass: its stated limit). Every contact
+  // above the centre of mass, pushing up on the whole (an object pressed under a table is not
+  // hanging: its contacts push down).
+  double lowest = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d up_push = Eigen::Vector3d::Zero();
+  for (const auto& p : contacts) {
+    lowest = std::min(lowest, p.p_W.z());
+    up_push += p.n_W;
+  }
+  if (lowest > com.z() + prm.tol && up_push.dot(kUp) > 0) return hangingStability(contacts, com, prm);
   // ---------------------------------------------------------------- planar case
   std::vector<Eigen::Vector3d> pts;
   for (const auto& p : contacts) pts.push_back(p.p_W);

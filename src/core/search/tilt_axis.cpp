@@ -25,6 +25,12 @@ TiltAxis tiltAxis(const std::vector<ContactPoint>& contacts, const Eigen::Vector
   constexpr double kParallel = 1e-2;
   if (spread <= tol) {
     a.layout = ContactLayout::kSingle;
+    // Hanging from one point (the centre of mass below it): it swings across its offset.
+    const Eigen::Vector3d off_h = (com - c) - (com - c).dot(d_g) * d_g;
+    if ((com - c).dot(d_g) > tol && off_h.norm() > 1e-6) {
+      a.d_A = off_h.cross(d_g).normalized();
+      return a;
+    }
     Eigen::Vector3d axis = k1.cross(d_g);
     if (axis.norm() < kParallel) axis = (c - com).cross(d_g);
     if (axis.norm() < kParallel * std::max(1e-9, (c - com).norm())) {

@@ -242,6 +242,7 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     n.quality = s.quality;
     n.tipping_angle = s.tipping_angle;
     n.supported = supported;
+    n.hanging = s.hanging;
     if (kTrace)
       std::fprintf(stderr, "node root %d depth %d opt %d: %zu contacts layout %d planar %d stable %d tip %.1f deg Q %.3f slips %d d_f %.2f %.2f %.2f\n",
                    n.root, n.depth, n.opt, n.contacts.size(), (int)axis.layout, s.planar, s.stable,
@@ -258,7 +259,7 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     // marker, a bottle). Its band of contacts is as wide as the contact tolerance, not as its
     // support, so it neither holds as a polygon nor tips about the band's edge: it rolls to
     // the bottom of its roll (rollStep) and holds there when a roll either way lifts it.
-    const bool rolls = axis.layout == ContactLayout::kCollinear && s.com_inside &&
+    const bool rolls = axis.layout == ContactLayout::kCollinear && s.com_inside && !s.hanging &&
                        std::abs(axis.d_A.z()) < kMaxRollAxisSlope;
     if (line && rolls && n.roll == 1) {
       const bool holds = n.roll_margin >= ctx_.stability.min_tipping_angle;
@@ -305,7 +306,9 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
         leaf(false, true);
       }
     };
-    if (falls) {
+    if (s.hanging && s.stable) {
+      leaf(true, true);  // hanging at the bottom of its swing (on a point or a line, too)
+    } else if (falls) {
       TreeLeaf l{n.X_GO, n.root, false, true, supported, s.quality, s.tipping_angle, n.contacts, n.path};
       l.fell = true;
       leaves.push_back(std::move(l));
@@ -344,6 +347,7 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
 // Exact angles to the next contact, vertex/surface and edge/edge, in both directions.
 void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
   std::vector<RotationQuery> q;
+  std::vector<std::pair<double, double>> swing;  // ccw, cw: a hanging object's swing to rest
   for (const TreeNode& n : rotating_) {
     RotationQuery rq{n.X_GO, toV3(n.s_A), toV3(n.d_A)};
     // Of the tree's two branches only those that lower the centre of mass are followed:
@@ -372,6 +376,16 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
     // Directions a contact blocks, or not asked for, are not searched (limit 0).
     if (blocked(n.contacts, n.s_A, n.d_A, 1, 1.5 * ctx_.cd)) rq.limit_ccw = 0;
     if (!n.both_directions || blocked(n.contacts, n.s_A, n.d_A, -1, 1.5 * ctx_.cd)) rq.limit_cw = 0;
+    // The swing (beyond the paper): a hanging object turns about its support until its centre
+    // of mass is straight below the axis, unless a contact stops it first. Its lever's height
+    // after a turn t is A cos t + B sin t, lowest at t* = atan2(-B, -A).
+    swing.push_back({kInf, kInf});
+    if (n.hanging && lev.norm() > 1e-9) {
+      const double A = lev.z(), B = n.d_A.cross(lev).z();
+      const double t = std::atan2(-B, -A);
+      if (t > 0 && t <= rq.limit_ccw) swing.back().first = t;
+      if (t < 0 && -t <= rq.limit_cw) swing.back().second = -t;
+    }
     q.push_back(rq);
   }
   std::vector<AnglePair> av, ae;
@@ -392,7 +406,9 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
     bool turned = false;
     for (int sigma : {1, -1}) {
       if (sigma < 0 && !n.both_directions) continue;
-      const double a = sigma > 0 ? std::min(av[i].ccw, ae[i].ccw) : std::min(av[i].cw, ae[i].cw);
+      double a = sigma > 0 ? std::min(av[i].ccw, ae[i].ccw) : std::min(av[i].cw, ae[i].cw);
+      const double sw = sigma > 0 ? swing[i].first : swing[i].second;
+      if (sw < a) a = sw;  // it swings to rest before anything stops it
       if (kTrace)
         std::fprintf(stderr, "root %d depth %d sigma %d angle %.2f deg\n", n.root, n.depth, sigma, a * 180 / M_PI);
       if (a >= kInf) continue;  // blocked, or turns freely: no resting pose that way

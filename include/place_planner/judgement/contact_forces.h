@@ -74,8 +74,9 @@ PushResistance pushResistance(const std::vector<ContactPoint>& contacts, const E
 // horizontal unit direction (G) it slips in: against the friction the wide cones use beyond
 // mu, summed over the contacts (a plate leaning on a peg, its foot kicking out). Zero when it
 // does not slip so (balanced, or not even with mu_hold: it tips or falls).
+// known_unbalanced: the caller found gravity not balanced with params already (skips that test).
 Eigen::Vector3d slipDirection(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
-                              const ForceModelParams& params, double mu_hold = 1.0);
+                              const ForceModelParams& params, double mu_hold = 1.0, bool known_unbalanced = false);
 
 // One-call form of ContactForces::balances (kept for the tests of the earlier API): the default
 // 8-edge cone, max_load as given.

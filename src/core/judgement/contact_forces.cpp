@@ -153,9 +153,9 @@ Eigen::Vector3d ContactForces::contactForce(const Eigen::VectorXd& forces, size_
 }
 
 Eigen::Vector3d slipDirection(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
-                              const ForceModelParams& params, double mu_hold) {
+                              const ForceModelParams& params, double mu_hold, bool known_unbalanced) {
   const Eigen::Vector3d g(0, 0, -1);
-  if (ContactForces(contacts, com, params).balances(g)) return Eigen::Vector3d::Zero();
+  if (!known_unbalanced && ContactForces(contacts, com, params).balances(g)) return Eigen::Vector3d::Zero();
   ForceModelParams wide = params;
   wide.friction = std::max(mu_hold, params.friction);
   const ContactForces held(contacts, com, wide);

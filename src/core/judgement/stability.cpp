@@ -139,7 +139,7 @@ Eigen::Vector3d slipOf(const std::vector<ContactPoint>& contacts, const Eigen::V
   double extent = 0;
   for (const ContactPoint& p : contacts) extent = std::max(extent, (p.p_W - contacts.front().p_W).norm());
   return slipDirection(reduceContacts(contacts, std::max(prm.tol, extent / 8)), com,
-                       ForceModelParams{prm.friction, 8, prm.max_load});
+                       ForceModelParams{prm.friction, 8, prm.max_load}, 1.0, true);
 }
 
 // Hanging: the forces balance gravity (the centre of mass straight below the support), and
@@ -172,8 +172,10 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
     reach = std::max(reach, (p.p_W - c).norm());
   }
   const Eigen::Vector3d off = com - c;
-  // Its margin: the swing the support allows before the centre of mass comes level with it.
-  r.tipping_angle = holds ? std::atan2(-off.z(), reach) : 0.0;
+  // Its margin: the swing the support allows before the centre of mass comes level with it;
+  // unstable, how far it is swung off straight below its support (negative: far off, over a
+  // drop, the tree's fall cut ends it as it does an object going over a ledge).
+  r.tipping_angle = holds ? std::atan2(-off.z(), reach) : -std::atan2(std::hypot(off.x(), off.y()), -off.z());
   r.quality = holds ? std::max(0.3, 1.0 - std::hypot(off.x(), off.y()) / reach) : -1.0;
   if (holds) {
     r.failure = Failure::kNone;

@@ -77,6 +77,15 @@ struct TreeScene {
   TreeContext ctx;
 };
 
+// The leaves of one tree: X released and dropped along -z (at most tmax), stepped to its end.
+std::vector<TreeLeaf> settle(const TreeContext& ctx, const Eigen::Isometry3d& X, const V3& com_O, double tmax) {
+  TreeStepper stepper(ctx);
+  stepper.addRoot(toRigid(X), 0, com_O, v3(0, 0, -1), tmax);
+  std::vector<TreeLeaf> leaves;
+  for (int i = 0; i < 200 && !stepper.empty(); ++i) stepper.step(leaves);
+  return leaves;
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------ resting faces (IV-A)
@@ -371,10 +380,7 @@ TEST(Search, LeaningBoardSlidesToTheStopBehindItsFoot) {
     zmin = std::min(zmin, (X.linear() * v).z());
   }
   X.translation() = Eigen::Vector3d(0.095 - xmax, 0, 0.003 - zmin);
-  TreeStepper stepper(scene.ctx);
-  stepper.addRoot(toRigid(X), 0, scene.om.com, v3(0, 0, -1), 0.1);
-  std::vector<TreeLeaf> leaves;
-  for (int i = 0; i < 200 && !stepper.empty(); ++i) stepper.step(leaves);
+  const std::vector<TreeLeaf> leaves = settle(scene.ctx, X, scene.om.com, 0.1);
   ASSERT_EQ(leaves.size(), 1u);
   const TreeLeaf& l = leaves.front();
   ASSERT_TRUE(l.stable) << "the board did not come to rest against the stop";
@@ -416,10 +422,7 @@ TEST(Search, RingSwingsToHangBelowAPeg) {
   scene.ctx.rock_settle = true;
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.translation() = Eigen::Vector3d(0.01, 0, 0.208 - (R - r));  // inner top 4 mm over the peg
-  TreeStepper stepper(scene.ctx);
-  stepper.addRoot(toRigid(X), 0, scene.om.com, v3(0, 0, -1), 0.05);
-  std::vector<TreeLeaf> leaves;
-  for (int i = 0; i < 200 && !stepper.empty(); ++i) stepper.step(leaves);
+  const std::vector<TreeLeaf> leaves = settle(scene.ctx, X, scene.om.com, 0.05);
   ASSERT_EQ(leaves.size(), 1u);
   const TreeLeaf& l = leaves.front();
   const Eigen::Vector3d com = toEigen(apply(l.X_GO, scene.om.com));
@@ -429,11 +432,7 @@ TEST(Search, RingSwingsToHangBelowAPeg) {
   for (const ContactPoint& c : l.contacts) EXPECT_GT(c.p_W.z(), 0.195) << "a contact below the peg's top";
   // Without the peg's top under it (the ring released beside the peg) nothing holds it.
   X.translation().x() = 0.05;
-  TreeStepper beside(scene.ctx);
-  beside.addRoot(toRigid(X), 1, scene.om.com, v3(0, 0, -1), 0.05);
-  leaves.clear();
-  for (int i = 0; i < 200 && !beside.empty(); ++i) beside.step(leaves);
-  for (const TreeLeaf& b : leaves) EXPECT_FALSE(b.stable);
+  for (const TreeLeaf& b : settle(scene.ctx, X, scene.om.com, 0.05)) EXPECT_FALSE(b.stable);
 }
 
 TEST(Robustness, MugTiltedOnPegTopsRocksBackUpright) {

@@ -27,6 +27,13 @@ enum class RankOrder {
   kNearest,  // nearest to prefer_near first
 };
 
+// Which placements the search offers (search/hanging_starts.h).
+enum class PlacementKind {
+  kAny,       // default: standing and hanging poses compete on the same ranking
+  kStanding,  // resting on the area from above (the paper)
+  kHanging,   // hanging by a loop of the object from a peg of the area
+};
+
 struct PlannerConfig {
   Eigen::Vector3d gravity{0.0, 0.0, -1.0};   // d_g, normalised by the planner
   Eigen::Vector3d approach{0.0, 0.0, 0.0};   // d_vis; zero = gravity (Section VII)
@@ -88,6 +95,7 @@ struct PlannerConfig {
   double retreat_distance = 0.10;            // m, the gripper backs off along -z of F
   double retreat_min_distance = 0.03;        // m
   // Preferences (ranking.h)
+  PlacementKind placement = PlacementKind::kAny;
   RankOrder rank_order = RankOrder::kQuality;
   Eigen::Vector3d prefer_near{0.0, 0.0, 0.0};  // W, for kNearest
   double min_edge_clearance = 0.0;           // m from a drop-off of the area (0 = off)
@@ -110,5 +118,8 @@ void validate(const PlannerConfig& config);
 
 OrientationMode orientationModeFromString(const std::string& s);  // throws on an unknown name
 std::string toString(OrientationMode m);
+// "any", "standing", "hanging"; `field` names the option in the error of an unknown name.
+PlacementKind placementKindFromString(const std::string& s, const std::string& field = "placement");
+const char* toString(PlacementKind k);
 
 }  // namespace place_planner

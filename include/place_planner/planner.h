@@ -43,7 +43,7 @@ enum class SupportKind { kSeen, kCompleted, kAreaBorder };
 const char* toString(SupportKind s);  // "seen", "completed", "area_border"
 
 // Which start orientation a candidate's tree began from (Section IV-A, generalised).
-enum class StartKind { kRestingFace, kHeld, kPrincipalAxis, kAreaTurn, kAxis };
+enum class StartKind { kRestingFace, kHeld, kPrincipalAxis, kAreaTurn, kAxis, kLoopOnPeg };
 const char* toString(StartKind k);
 
 // A straight motion (moveit_msgs/GripperTranslation): along `direction`, at least min_distance,
@@ -74,6 +74,9 @@ struct Candidate {
   Robustness robustness;
   PhysicsCheck physics;
   StartKind start = StartKind::kPrincipalAxis;
+  // It hangs: every contact above its centre of mass (a loop on a peg, a ring on a hook). Its
+  // approach threads the loop along the peg (placement.approach), then lowers it.
+  bool hanging = false;
   // What carries it (model/completion.h): kSeen, or surface the scans never saw: kCompleted (a
   // contact on a cap over an open region of the object) or kAreaBorder (a contact at the border
   // of what the area's scan saw). Those rank after every stable pose on seen surface.
@@ -104,7 +107,10 @@ struct StepTimes {  // wall time per batched step, ms
 };
 
 struct PlanStats {
-  int roots_total = 0;             // floor points x start orientations
+  int roots_total = 0;             // floor points x start orientations, and the hanging starts
+  int pegs = 0;                    // the area's pegs (search/pegs.h), when hanging is searched
+  int loops = 0;                   // the object's loops (search/loops.h), when pegs were found
+  int hanging_starts = 0;          // loop-on-peg roots threaded free
   int start_orientations = 0;
   int roll_bottoms = 0;            // leaves at the bottom of a roll (tree_stepper rollStep), stable or not
   int trees_without_rest = 0;      // trees cut by max_rotations before reaching a resting pose

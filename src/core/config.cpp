@@ -112,6 +112,21 @@ OrientationMode orientationModeFromString(const std::string& s) {
                               "' is unknown (use auto, principal_axis, keep or all_axes)");
 }
 
+PlacementKind placementKindFromString(const std::string& s, const std::string& field) {
+  if (s == "any" || s.empty()) return PlacementKind::kAny;
+  if (s == "standing") return PlacementKind::kStanding;
+  if (s == "hanging") return PlacementKind::kHanging;
+  throw std::invalid_argument(field + " = '" + s + "' is unknown (use any, standing or hanging)");
+}
+
+const char* toString(PlacementKind k) {
+  switch (k) {
+    case PlacementKind::kStanding: return "standing";
+    case PlacementKind::kHanging: return "hanging";
+    default: return "any";
+  }
+}
+
 std::string toString(OrientationMode m) {
   switch (m) {
     case OrientationMode::kKeep: return "keep";

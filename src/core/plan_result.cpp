@@ -10,6 +10,7 @@ const char* toString(StartKind k) {
     case StartKind::kPrincipalAxis: return "principal_axis";
     case StartKind::kAreaTurn: return "area_turn";
     case StartKind::kAxis: return "axis";
+    case StartKind::kLoopOnPeg: return "loop_on_peg";
   }
   return "?";
 }

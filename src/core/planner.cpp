@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <future>
 #include <mutex>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "place_planner/infra/backend.h"
 #include "place_planner/infra/cuda_backend.h"
 #include "place_planner/search/floor_points.h"
+#include "place_planner/search/hanging_starts.h"
 #include "place_planner/infra/parallel_for.h"
 #include "place_planner/judgement/penetration.h"
 #include "place_planner/manipulation/placeability.h"
@@ -220,6 +222,7 @@ struct SearchMonitor {
   Clock::time_point t0;
   double search_budget, penetration_limit;
   int orientations;
+  int hanging;  // roots before the floor points' (root_search.h)
   std::function<std::vector<Robustness>(const std::vector<size_t>&)> robustness;
   PlanResult& result;
   std::vector<std::pair<size_t, Robustness>> checked;  // leaf index, its robustness
@@ -277,7 +280,7 @@ struct SearchMonitor {
         ++stable_count;
         best_q = std::max(best_q, all[fresh[j]].quality);
       }
-    st.floor_points_done = (started - open) / std::max(1, orientations);
+    st.floor_points_done = std::max(0, started - open - hanging) / std::max(1, orientations);
     if (st.tree_nodes >= config.max_tree_nodes) {
       result.warnings.push_back("search stopped after max_tree_nodes = " + std::to_string(config.max_tree_nodes) +
                                 " poses; " + std::to_string(st.floor_points_done) + " of " +
@@ -335,6 +338,9 @@ struct Models {
   std::shared_ptr<const AreaModel> am;
   V3 d_vis{0, 0, -1};  // approach direction, G
   std::unique_ptr<Backend> backend;
+  // The area's pegs (search/pegs.h), found beside the object's model while it is built; empty
+  // unless hanging is asked for.
+  std::vector<Peg> pegs;
   const Mesh& searched(const Mesh& object) const { return object_small ? *object_small : object; }
 };
 
@@ -353,7 +359,9 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache) {
   const bool built = runStoppable(
                          [&] {
                            auto area_model = std::async(std::launch::async, [&] {
-                             return cache.get(run.area, m.d_g_W, m.rad.r_area, m.rad.cd, m.rad.cell, max_tri, &run.stop);
+                             auto am = cache.get(run.area, m.d_g_W, m.rad.r_area, m.rad.cd, m.rad.cell, max_tri, &run.stop);
+                             if (config.placement != PlacementKind::kStanding) m.pegs = findPegs(*am, {}, &run.stop);
+                             return am;
                            });
                            if (run.object.triangles.size() > max_tri)
                              m.object_small = decimated(run.object, max_tri, &m.object_cell, &run.stop);
@@ -385,6 +393,7 @@ struct Roots {
   Eigen::Matrix3d R_held_G;
   std::vector<V3> floor_G;
   std::vector<StartOrientation> orientations;
+  std::vector<HangingStart> hanging;  // the object threaded by a loop on a peg (beyond the paper)
 };
 
 std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
@@ -394,21 +403,38 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
   const auto tp = Clock::now();
   std::vector<std::string> floor_warnings;
   std::vector<StartOrientation> all;
+  const std::vector<Peg>& pegs = m.pegs;
+  std::vector<Loop> loops;
+  const PlacementKind kind = run.config.placement;
   const bool found = runStoppable(
                          [&] {
                            r.floor_G = findFloorPoints(am, run.config, m.d_vis, &run.stop, floor_warnings);
-                           all = startOrientations(m.searched(run.object), r.R_held_G, toEigen(m.d_vis), am,
-                                                   run.config, &run.stop);
+                           if (kind != PlacementKind::kHanging)
+                             all = startOrientations(m.searched(run.object), r.R_held_G, toEigen(m.d_vis), am,
+                                                     run.config, &run.stop);
+                           // Hanging (beyond the paper): the object's loops, when the area has a
+                           // peg to hang them on (buildModels).
+                           if (!pegs.empty()) loops = findLoops(m.searched(run.object), {}, &run.stop);
                            return true;
                          },
                          run.stop, run.setup_going)
                          .has_value();
-  run.st().steps.floor_points = msSince(tp);
   for (std::string& w : floor_warnings) run.result.warnings.push_back(std::move(w));
   if (!found) return std::nullopt;
+  for (const HangingStart& h : hangingStarts(pegs, loops, m.om, *m.backend, m.rad.cd))
+    if (gripperTiltOk(toIsometry(h.X_GO).linear(), run.config)) r.hanging.push_back(h);
+  run.st().steps.floor_points = msSince(tp);
+  run.st().pegs = static_cast<int>(pegs.size());
+  run.st().loops = static_cast<int>(loops.size());
+  run.st().hanging_starts = static_cast<int>(r.hanging.size());
+  if (kind == PlacementKind::kHanging && r.hanging.empty())
+    run.result.warnings.push_back(
+        "placement = hanging, but nothing to hang on: " + std::to_string(pegs.size()) + " pegs on the area, " +
+        std::to_string(loops.size()) + " loops of the object" +
+        (pegs.empty() || loops.empty() ? "" : ", none threaded free (too short, too thick or blocked)"));
   for (const StartOrientation& o : all)
     if (gripperTiltOk(o.R_GO, run.config)) r.orientations.push_back(o);
-  if (r.orientations.empty())
+  if (r.orientations.empty() && kind != PlacementKind::kHanging)
     run.result.warnings.push_back("no start orientation points the gripper within max_gripper_tilt_deg of straight down");
   for (const V3& p : r.floor_G) run.result.floor_points_W.push_back(am.R_GW.transpose() * toEigen(p));
   run.st().floor_points_total = static_cast<int>(r.floor_G.size());
@@ -423,13 +449,13 @@ class TreeSearch {
   TreeSearch(PlanRun& run, const Models& m, const Roots& r)
       : run_(run),
         m_(m),
-        roots_(r.floor_G, r.orientations, m.searched(run.object).properties, *m.am, m.d_vis),
+        roots_(r.floor_G, r.orientations, m.searched(run.object).properties, *m.am, m.d_vis, r.hanging),
         ctx_(treeContext(m.searched(run.object), m.om, *m.am, *m.backend, m.rad, run.config, run.st())),
         rp_(robustnessParams(run.config, run.run_completion())),
         // With the robustness check on, the search leaves a share of the budget for it.
         monitor_{m.om, *m.am, run.config, run.progress, run.t0,
                  run.budget * (run.config.robust_check ? kSearchShareOfBudget : 1.0), m.rad.r,
-                 static_cast<int>(r.orientations.size()),
+                 static_cast<int>(r.orientations.size()), static_cast<int>(r.hanging.size()),
                  [this](const std::vector<size_t>& idx) { return robustness(idx); }, run.result, {}, 0, 1, 0.0, 0} {
     run.st().roots_total = roots_.size();
   }
@@ -452,7 +478,7 @@ class TreeSearch {
     std::vector<Eigen::Vector3d> floor_W(roots_.size());
     for (int k = 0; k < roots_.size(); ++k) {
       kinds[k] = roots_.kind(k);
-      floor_W[k] = run_.result.floor_points_W[roots_.floorPoint(k)];
+      floor_W[k] = m_.am->R_GW.transpose() * toEigen(roots_.floorPointG(k));
     }
     const MeshProperties& props = m_.searched(run_.object).properties;
     RankingInput in{leaves_, kinds, floor_W, m_.am->R_GW, r.R_held_G, props.bounding_radius, props.center_of_mass};
@@ -481,7 +507,7 @@ class TreeSearch {
     const PlaceabilityContext pc{m_.om, *m_.am, *m_.backend, m_.d_vis, config};
     run_.result.candidates = rankCandidates(
         in, config, [&](const std::vector<size_t>& idx) { return monitor_.robustnessOf(idx); }, &run_.st(),
-        [&](size_t i) { return checkPlacement(leaves_[i], pc); });
+        [&](size_t i) { return checkPlacement(leaves_[i], pc, roots_.hanging(leaves_[i].root)); });
     if (config.has_grasp && config.gripper && run_.result.stableCount() == 0 && run_.st().gripper_rejected > 0)
       run_.result.warnings.push_back("the gripper blocks every stable pose checked (" +
                                      std::to_string(run_.st().gripper_rejected) +
@@ -493,8 +519,21 @@ class TreeSearch {
   std::vector<Robustness> robustness(const std::vector<size_t>& idx) {
     const auto tr = Clock::now();
     std::vector<Rigid> X;
-    for (size_t i : idx) X.push_back(leaves_[i].X_GO);
-    auto out = checkRobustness(X, ctx_, rp_, [this] { return monitor_.keepGoing(run_.budget); });
+    std::vector<Eigen::Vector3d> supports;  // hanging leaves: the middle of their contacts
+    std::vector<PegLine> pegs;
+    for (size_t i : idx) {
+      const TreeLeaf& l = leaves_[i];
+      X.push_back(l.X_GO);
+      pegs.push_back(l.peg);
+      Eigen::Vector3d c = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+      if (l.hanging && !l.contacts.empty()) {
+        c.setZero();
+        for (const ContactPoint& p : l.contacts) c += p.p_W;
+        c /= static_cast<double>(l.contacts.size());
+      }
+      supports.push_back(c);
+    }
+    auto out = checkRobustness(X, ctx_, rp_, [this] { return monitor_.keepGoing(run_.budget); }, supports, pegs);
     run_.st().robustness_ms += msSince(tr);
     return out;
   }

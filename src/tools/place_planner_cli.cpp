@@ -261,6 +261,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
         {"push_resistance",
          {{"min", k.push_resistance}, {"mean", k.push_resistance_mean}, {"weakest_direction", vecJson(k.push_weakest_W)}}},
         {"start", toString(k.start)},
+        {"kind", k.hanging ? "hanging" : "standing"},
         {"robustness",
          {{"trials", k.robustness.trials},
           {"held", k.robustness.held},
@@ -308,6 +309,9 @@ void printReport(const std::string& object_spec, const Mesh& object, const std::
   std::printf("floor points %d of %d, tree nodes %ld, planning %.1f ms, first stable %.1f ms, %s backend\n",
               st.floor_points_done, st.floor_points_total, st.tree_nodes, st.total_ms, st.first_stable_ms,
               st.backend == "cuda" ? "CUDA" : "CPU");
+  if (st.pegs > 0)
+    std::printf("hanging: %d pegs on the area, %d loops of the object, %d threaded starts\n", st.pegs, st.loops,
+                st.hanging_starts);
   if (st.trees_without_rest > 0 || st.roll_bottoms > 0 || st.trees_fallen > 0)
     std::printf("trees: %d cut by max_rotations while still tilting, %d ended at the bottom of a roll, "
                 "%d cut while falling over a ledge\n",
@@ -320,15 +324,15 @@ void printReport(const std::string& object_spec, const Mesh& object, const std::
 }
 
 void printTable(const PlanResult& r) {
-  std::printf("%4s %7s %6s %6s %7s %-14s %26s %32s %8s\n", "rank", "quality", "stable", "robust",
-              "physics", "start", "position [m]", "orientation xyzw", "contacts");
+  std::printf("%4s %7s %6s %6s %7s %-14s %-8s %26s %32s %8s\n", "rank", "quality", "stable", "robust",
+              "physics", "start", "kind", "position [m]", "orientation xyzw", "contacts");
   for (size_t i = 0; i < r.candidates.size(); ++i) {
     const auto& k = r.candidates[i];
     const Eigen::Quaterniond q(k.X_WO.linear());
     const Eigen::Vector3d p = k.X_WO.translation();
-    std::printf("%4zu %7.3f %6s %6s %7s %-14s (%7.3f %7.3f %7.3f) (%6.3f %6.3f %6.3f %6.3f) %8zu\n", i + 1,
+    std::printf("%4zu %7.3f %6s %6s %7s %-14s %-8s (%7.3f %7.3f %7.3f) (%6.3f %6.3f %6.3f %6.3f) %8zu\n", i + 1,
                 k.quality, k.stable ? "yes" : "no", robustnessCell(k.robustness).c_str(),
-                physicsCell(k.physics).c_str(), toString(k.start), p.x(), p.y(), p.z(), q.x(), q.y(), q.z(),
+                physicsCell(k.physics).c_str(), toString(k.start), k.hanging ? "hanging" : "standing", p.x(), p.y(), p.z(), q.x(), q.y(), q.z(),
                 q.w(), k.contacts.size());
   }
 }
@@ -516,6 +520,13 @@ int main(int argc, char** argv) {
   // Preferences (ranking.h).
   const std::map<std::string, RankOrder> orders = {
       {"quality", RankOrder::kQuality}, {"lowest", RankOrder::kLowest}, {"nearest", RankOrder::kNearest}};
+  const std::map<std::string, PlacementKind> kinds = {
+      {"any", PlacementKind::kAny}, {"standing", PlacementKind::kStanding}, {"hanging", PlacementKind::kHanging}};
+  std::string placement_name = "any";
+  app.add_option("--placement", placement_name,
+                 "any | standing | hanging (by a loop of the object on a peg of the area)")
+      ->check(CLI::IsMember(kinds))
+      ->capture_default_str();
   std::string order_name = "quality";
   app.add_option("--rank-order", order_name, "quality | lowest | nearest (to --prefer-near)")
       ->check(CLI::IsMember(orders))
@@ -552,6 +563,7 @@ int main(int argc, char** argv) {
     if (verify_k > 0) throw InputError("--verify: built without Bullet (no validation library)");
 #endif
     c.rank_order = orders.at(order_name);
+    c.placement = kinds.at(placement_name);
     if (!urdf_path.empty() || !gripper_links.empty()) {
       if (urdf_path.empty() || gripper_links.empty())
         throw InputError("--urdf and --gripper-links go together (the gripper needs both)");

@@ -66,6 +66,8 @@ void validateConfig(const ValidatorConfig& c) {
   require(c.time_step > 0 && c.time_step <= 0.02, "time_step", c.time_step, "(0, 0.02] s");
   require(c.solver_iterations >= 1, "solver_iterations", c.solver_iterations, "must be >= 1");
   require(c.margin > 0, "margin", c.margin, "must be > 0");
+  require(c.linear_damping >= 0 && c.linear_damping <= 1, "linear_damping", c.linear_damping, "must be in [0, 1]");
+  require(c.angular_damping >= 0 && c.angular_damping <= 1, "angular_damping", c.angular_damping, "must be in [0, 1]");
   require(c.world_scale >= 0.01 && c.world_scale <= 1000, "world_scale", c.world_scale, "[0.01, 1000]");
   require(c.piece_thickness >= 0, "piece_thickness", c.piece_thickness, "must be >= 0");
   require(c.piece_max_triangles >= 1, "piece_max_triangles", c.piece_max_triangles, ">= 1");
@@ -330,6 +332,8 @@ struct PhysicsValidator::Impl {
                                                 inertia);
     oi.m_friction = btScalar(cfg.friction);
     oi.m_restitution = 0.0;
+    oi.m_linearDamping = btScalar(cfg.linear_damping);
+    oi.m_angularDamping = btScalar(cfg.angular_damping);
     oi.m_startWorldTransform = toBullet(X_WO * Eigen::Translation3d(c_O));
     s->body = std::make_unique<btRigidBody>(oi);
     s->body->setActivationState(DISABLE_DEACTIVATION);

@@ -22,6 +22,8 @@ Mesh ellipticCylinder(double a, double b, double h, int segments = 32);
 Mesh plane(double size_x, double size_y, double tilt_deg = 0.0);
 // Two planes forming a V trough along x, each tilted by +-angle_deg, meeting at z = 0.
 Mesh vTrough(double size, double angle_deg);
+// Closed torus about z: ring radius R, tube radius r, outward CCW (a napkin ring, a roll of tape).
+Mesh torus(double R, double r, int segments = 48, int sides = 12);
 // Appends b to a (vertices re-indexed); the result is rebuilt and validated.
 Mesh merge(const std::vector<Mesh>& parts, const std::string& name = "merged");
 
@@ -35,13 +37,20 @@ Mesh binderStack();   // three binders stacked with offsets on a table top
 // so it is approached from the side (d_vis = +y). Every face split into `subdivisions`^2 quads
 // (12: about 15k triangles, the size of a scanned shelf).
 Mesh shelfUnit(int subdivisions = 12);
+// A wall 0.6 x 0.6 m (its face at y = +0.09) with two rows of three pegs 10 cm long sticking
+// out towards -y, rising rise_deg towards their tips (coat pegs); nothing to stand on but the
+// wall's 2 cm top and the pegs.
+Mesh pegWall(double rise_deg = 0.0);
+// A mug tree: a foot 0.2 m across, a post and four arms rising 25 degrees at two heights.
+Mesh mugTree();
 // Demo objects (mesh frame at their base centre, like a scan).
 Mesh mug();           // cylinder body with a handle, 0.08 m diameter
 Mesh plate();         // flat disc 0.24 m, 2 cm thick rim
 Mesh pen();           // thin cylinder 0.14 m long
+Mesh loopMug();       // the mug with a handle it can hang by: an opening 5.8 x 2.4 cm
 
-// Names accepted by byName(): table, dish_rack, open_box, binder_stack, shelf, mug, plate, pen,
-// cube.
+// Names accepted by byName(): table, dish_rack, open_box, binder_stack, shelf, peg_wall,
+// mug_tree, mug, loop_mug, ring (torus 6 cm across, 12 mm thick), plate, pen, cube.
 Mesh byName(const std::string& name);
 std::vector<std::string> areaNames();
 std::vector<std::string> objectNames();

@@ -45,8 +45,13 @@ struct RobustnessParams {
 // Settles 12 perturbed releases of each pose with the planner's own kernels (translation to
 // contact, contact points, a few tilts, local optimisation) and counts those that end stable
 // near it. `keep_going` is asked between batched steps; false stops (unfinished trials fail).
+// A hanging pose (`supports`[i] finite: the middle of its contacts, G) is tilted about its
+// support, not its centre of mass: a swing of the pendulum, its loop left on the peg; its
+// trials swing on its peg (`pegs`[i], TreeNode::peg).
 std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const TreeContext& ctx,
                                         const RobustnessParams& params,
-                                        const std::function<bool()>& keep_going = {});
+                                        const std::function<bool()>& keep_going = {},
+                                        const std::vector<Eigen::Vector3d>& supports = {},
+                                        const std::vector<PegLine>& pegs = {});
 
 }  // namespace place_planner

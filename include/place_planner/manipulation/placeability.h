@@ -10,6 +10,7 @@
 #include "place_planner/config.h"
 #include "place_planner/manipulation/gripper.h"
 #include "place_planner/planner.h"
+#include "place_planner/search/hanging_starts.h"
 #include "place_planner/search/tree_stepper.h"
 
 namespace place_planner {
@@ -29,7 +30,9 @@ constexpr double kMotionStep = 0.005;
 // pose", "approach" (the gripper within approach_min_distance), "retreat" (within
 // retreat_min_distance), "edge" (min_edge_clearance: the area drops off nearer than that
 // around the object's footprint) — or is empty.
-Placement checkPlacement(const TreeLeaf& leaf, const PlaceabilityContext& ctx);
+// A hanging leaf (its root's `hanging` start) is approached along its peg, threaded, to the
+// first pose of its path, then lowered: its pre-place pose is beyond the peg's tip.
+Placement checkPlacement(const TreeLeaf& leaf, const PlaceabilityContext& ctx, const HangingStart* hanging = nullptr);
 
 // With a grasp: does F's z axis (the approach axis) at this pose point within
 // max_gripper_tilt_deg of straight down (gravity, -z of G)? True without a grasp.

@@ -6,6 +6,7 @@
 
 #include "place_planner/model/mesh.h"
 #include "place_planner/model/scene.h"
+#include "place_planner/search/hanging_starts.h"
 #include "place_planner/search/start_orientations.h"
 
 namespace place_planner {
@@ -17,21 +18,31 @@ std::vector<V3> orderFloorPoints(const std::vector<V3>& points, double spacing);
 
 class RootSearch {
  public:
-  // Roots k = f * |orientations| + o: for each floor point (in order), every orientation
-  // (likeliest first), so the first trees cover the likeliest orientations.
+  // The hanging starts first (few, each a peg the object is threaded on), then roots
+  // H + f * |orientations| + o: for each floor point (in order), every orientation (likeliest
+  // first), so the first trees cover the likeliest orientations.
   RootSearch(const std::vector<V3>& floor_points_G, const std::vector<StartOrientation>& orientations,
-             const MeshProperties& object, const AreaModel& area, const V3& d_vis_G);
-  int size() const { return static_cast<int>(floor_points_.size() * orientations_.size()); }
-  int floorPoint(int root) const { return root / static_cast<int>(orientations_.size()); }
-  StartKind kind(int root) const { return orientations_[root % orientations_.size()].kind; }
+             const MeshProperties& object, const AreaModel& area, const V3& d_vis_G,
+             std::vector<HangingStart> hanging = {});
+  int size() const { return hangingCount() + static_cast<int>(floor_points_.size() * orientations_.size()); }
+  int hangingCount() const { return static_cast<int>(hanging_.size()); }
+  // The root's hanging start, null for a root over a floor point.
+  const HangingStart* hanging(int root) const { return root < hangingCount() ? &hanging_[root] : nullptr; }
+  // Index into the floor points (roots over a floor point only).
+  int floorPoint(int root) const { return (root - hangingCount()) / static_cast<int>(orientations_.size()); }
+  // Where the root's tree starts on the area: its floor point, or the point of its peg.
+  V3 floorPointG(int root) const;
+  StartKind kind(int root) const;
   // The root's pose: centre of mass above the floor point along -d_vis, clear of everything
-  // (V-A, first step), and the translation to do along d_vis.
+  // (V-A, first step), or threaded on its peg; and the translation to do, along direction().
   Rigid pose(int root) const;
   double tmax(int root) const;
+  V3 direction(int root) const { return hanging(root) ? v3(0, 0, -1) : d_vis_; }
   double clearance(int root) const;
   const V3& d_vis() const { return d_vis_; }
 
  private:
+  std::vector<HangingStart> hanging_;
   std::vector<V3> floor_points_;
   std::vector<StartOrientation> orientations_;
   Eigen::Vector3d com_O_;

@@ -14,6 +14,13 @@
 
 namespace place_planner {
 
+// The axis of the peg a hanging root is threaded on (search/hanging_starts.h), frame G.
+struct PegLine {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();  // unit; zero: no peg known
+  bool known() const { return axis.squaredNorm() > 0; }
+};
+
 struct TreeNode {
   Rigid X_GO;
   int root = 0;       // caller's id of the tree (root index, or robustness trial)
@@ -40,6 +47,14 @@ struct TreeNode {
   bool held = false;      // its last stability test held it with margin (rocked when only balanced)
   bool overhang = false;  // its last pose was past its support over a drop (see fall_tip)
   bool hanging = false;   // its last stability test found every contact above the centre of mass
+  // The swing (swingStep): its step (rad; 0 before the first), how many it took, and whether
+  // no move lowers it any more (its rest).
+  double swing_step = 0;
+  int swings = 0;
+  bool swung = false;
+  // The peg it was threaded on, if any. The swing turns the loop round the peg and slides it
+  // across, never along it: along it friction decides.
+  PegLine peg;
 };
 
 struct TreeLeaf {
@@ -56,6 +71,8 @@ struct TreeLeaf {
   std::vector<Rigid> path;
   bool rolled = false;  // it came to rest at the bottom of a roll (rollStep)
   bool fell = false;    // the tree was cut while falling over a ledge (TreeContext::fall_tip)
+  bool hanging = false;  // its last stability test found every contact above the centre of mass
+  PegLine peg;  // its tree's peg (TreeNode), if any
 };
 
 struct TreeContext {
@@ -81,9 +98,12 @@ class TreeStepper {
  public:
   explicit TreeStepper(const TreeContext& ctx);
   // A tree: its first pose X_GO (also the first entry of its path) and the translation to do.
-  void addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax);
+  // peg: the peg a hanging root is threaded on (TreeNode::peg), if any.
+  void addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax,
+               const PegLine& peg = {});
   size_t active() const {
-    return translate_.size() + contact_.size() + rotating_.size() + rolling_.size() + rocking_.size();
+    return translate_.size() + contact_.size() + rotating_.size() + rolling_.size() + rocking_.size() +
+           swinging_.size();
   }
   bool empty() const { return active() == 0; }
   // One batched step of every pending pose; trees that end append their leaves.
@@ -99,9 +119,10 @@ class TreeStepper {
   void tiltStep(std::vector<TreeLeaf>& leaves);   // V-C.2
   void rollStep();                                // beyond the paper: a roller's rest
   void rockStep(std::vector<TreeLeaf>& leaves);   // beyond the paper: at rest, or rocking
+  void swingStep();                               // beyond the paper: a hanging object's swing
   TreeContext ctx_;
   double diag_;  // of the area's bounds, limits slides
-  std::vector<TreeNode> translate_, contact_, rotating_, rolling_, rocking_;
+  std::vector<TreeNode> translate_, contact_, rotating_, rolling_, rocking_, swinging_;
 };
 
 // Rotation by `angle` about the axis (s, d) applied after X.

@@ -51,6 +51,11 @@ struct ValidatorConfig {
   double piece_max_normal_deg = 40.0;    // piece triangles' normals within this of the seed's
   double piece_max_size = 0.05;          // m, largest distance of a piece triangle from its seed
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2, world frame
+  // Bullet's velocity damping of the object (fraction of velocity lost per second, 0..1): a
+  // hanging object is a pendulum that swings for long undamped; light damping lets it settle
+  // within settle_time as air and the joint would. 0 = none (the default).
+  double linear_damping = 0.0;
+  double angular_damping = 0.0;
   // Stability check: simulate `settle_time` from the goal pose, released `release_gap`
   // above it (against gravity: a body started exactly in contact is pushed off by the margins);
   // confirmed when the object's centre of mass moved less than `max_translation` and the object

@@ -1,5 +1,6 @@
 #include "place_planner/infra/scenes.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <stdexcept>
 
@@ -161,12 +162,68 @@ Mesh shelfUnit(int n) {
   return b.build("shelf");
 }
 
+Mesh pegWall(double rise_deg) {
+  Builder b;
+  b.add(box(0.6, 0.02, 0.6, {0, 0.1, 0.3}));
+  // Pegs 12 mm thick sticking out 10 cm towards -y, rising towards their tips, 20 cm apart.
+  const double kRise = rise_deg * M_PI / 180;
+  const Eigen::Matrix3d along_y =
+      Eigen::AngleAxisd(-M_PI / 2 - kRise, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (const double z : {0.3, 0.5})
+    for (const double x : {-0.2, 0.0, 0.2})
+      b.add(cylinder(0.006, 0.1, 12), along_y, {x, 0.092 - 0.05 * std::cos(kRise), z + 0.05 * std::sin(kRise)});
+  return b.build("peg_wall");
+}
+
+Mesh mugTree() {
+  Builder b;
+  b.add(cylinder(0.1, 0.02, 32), Eigen::Matrix3d::Identity(), {0, 0, 0.01});
+  b.add(cylinder(0.012, 0.36, 16), Eigen::Matrix3d::Identity(), {0, 0, 0.2});
+  // Four arms 9 cm long, 10 mm thick, rising 25 degrees, at two heights.
+  for (int k = 0; k < 4; ++k) {
+    const double yaw = M_PI / 2 * k;
+    const Eigen::Vector3d dir(std::cos(yaw) * std::cos(25 * M_PI / 180), std::sin(yaw) * std::cos(25 * M_PI / 180),
+                              std::sin(25 * M_PI / 180));
+    const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), dir).toRotationMatrix();
+    const double z = k % 2 ? 0.22 : 0.30;
+    b.add(cylinder(0.005, 0.09, 12), R, Eigen::Vector3d(0, 0, z) + (0.01 + 0.045) * dir);
+  }
+  return b.build("mug_tree");
+}
+
 Mesh mug() {
   Builder b;
   const Mesh body = cylinder(0.04, 0.1, 24);
   b.add(body, Eigen::Matrix3d::Identity(), {0, 0, 0.05});
   b.add(box(0.02, 0.015, 0.06), Eigen::Matrix3d::Identity(), {0.05, 0, 0.05});
   return b.build("mug");
+}
+
+Mesh torus(double R, double r, int segments, int sides) {
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::vector<int>> f;
+  for (int i = 0; i < segments; ++i)
+    for (int j = 0; j < sides; ++j) {
+      const double u = 2 * M_PI * i / segments, w = 2 * M_PI * j / sides;
+      v.emplace_back((R + r * std::cos(w)) * std::cos(u), (R + r * std::cos(w)) * std::sin(u), r * std::sin(w));
+    }
+  for (int i = 0; i < segments; ++i)
+    for (int j = 0; j < sides; ++j) {
+      const int a = i * sides + j, b = ((i + 1) % segments) * sides + j, c = ((i + 1) % segments) * sides + (j + 1) % sides,
+                d = i * sides + (j + 1) % sides;
+      f.push_back({a, b, c, d});
+    }
+  return buildMesh(v, f, "torus");
+}
+
+Mesh loopMug() {
+  Builder b;
+  b.add(cylinder(0.04, 0.1, 24), Eigen::Matrix3d::Identity(), {0, 0, 0.05});
+  // A C of three bars: an opening 2.8 cm tall and 2 cm deep, 1.6 cm across.
+  b.add(box(0.026, 0.016, 0.01, {0.051, 0, 0.084}));
+  b.add(box(0.026, 0.016, 0.01, {0.051, 0, 0.016}));
+  b.add(box(0.01, 0.016, 0.078, {0.069, 0, 0.05}));
+  return b.build("loop_mug");
 }
 
 Mesh plate() {
@@ -190,9 +247,13 @@ Mesh byName(const std::string& n) {
   if (n == "mug") return mug();
   if (n == "plate") return plate();
   if (n == "pen") return pen();
+  if (n == "peg_wall") return pegWall();
+  if (n == "mug_tree") return mugTree();
+  if (n == "loop_mug") return loopMug();
+  if (n == "ring") return torus(0.03, 0.006);
   if (n == "cube") return box(0.1, 0.1, 0.1, {0, 0, 0.05});
   throw std::invalid_argument("unknown built-in scene '" + n +
-                              "' (table, dish_rack, open_box, binder_stack, shelf, mug, plate, pen, cube)");
+                              "' (table, dish_rack, open_box, binder_stack, shelf, peg_wall, mug_tree, mug, loop_mug, ring, plate, pen, cube)");
 }
 
 std::vector<std::string> areaNames() { return {"table", "dish_rack", "open_box", "binder_stack"}; }

@@ -71,6 +71,10 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
   for (size_t i = 0; i < leaves.size(); ++i) {
     const TreeLeaf& l = leaves[i];
     if (l.quality < config.min_quality) continue;
+    // The kind of placement asked for (config.h): hanging or standing only.
+    if ((config.placement == PlacementKind::kStanding && l.hanging) ||
+        (config.placement == PlacementKind::kHanging && !l.hanging))
+      continue;
     const Eigen::Isometry3d X = toIsometry(l.X_GO);
     if (!gripperTiltOk(X.linear(), config)) {
       if (stats) ++stats->gripper_tilt_rejected;
@@ -218,6 +222,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     c.support = it.support;
     c.robustness = it.robustness;
     c.start = in.root_kind[l.root];
+    c.hanging = l.hanging;
     c.reorientation = it.reorientation;
     if (it.pushed) {
       c.push_resistance = it.push.min;

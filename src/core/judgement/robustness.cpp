@@ -6,11 +6,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 
 namespace place_planner {
 namespace {
 
 constexpr int kTrials = 12;
+// A hanging pose's trials are not pruned by their turn (see the hold test).
+constexpr double kPendulumTurn = 1e9;
 const bool kTraceTrials = std::getenv("PP_ROBUST_TRACE") != nullptr;
 
 struct Trial {
@@ -32,7 +35,7 @@ Eigen::Vector2d horizontalExtent(const Rigid& X, const ObjectModel& om) {
 }
 
 Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const Eigen::Vector2d& extent,
-                const RobustnessParams& p) {
+                const RobustnessParams& p, const Eigen::Vector3d& support) {
   const Eigen::Vector3d dirs[4] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
   const Eigen::Vector3d d = dirs[k % 4];
   Trial t{X, om.com};
@@ -40,11 +43,16 @@ Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const Eigen::Vecto
   double lift = p.lift;
   if (k < 4) {
     t.X_start.t = t.X_start.t + toV3(p.shift * d);
+    if (support.allFinite()) lift += p.shift;  // hanging: so that a loop moved across its peg clears it
   } else if (k < 8) {
     // Tilted about the horizontal axis perpendicular to d: lifted clear of what it turns into.
     const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ().cross(d);
-    t.X_start = rotatedAbout(X, com, axis, p.tilt);
-    lift += std::sin(p.tilt) * om.bounding_radius;
+    if (support.allFinite()) {
+      t.X_start = rotatedAbout(X, support, axis, p.tilt);  // hanging: swung about its support
+    } else {
+      t.X_start = rotatedAbout(X, com, axis, p.tilt);
+      lift += std::sin(p.tilt) * om.bounding_radius;
+    }
   } else {
     // The centre of mass off horizontally (G) by com_offset times the object's extent along
     // that direction (a slender object's error is slender too), expressed in O.
@@ -60,7 +68,8 @@ Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const Eigen::Vecto
 namespace {
 std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext& ctx_in,
                               const RobustnessParams& p, const std::function<bool()>& keep_going,
-                              bool tilted_trials) {
+                              bool tilted_trials, const std::vector<Eigen::Vector3d>& supports,
+                              const std::vector<PegLine>& pegs) {
   TreeContext ctx = ctx_in;
   ctx.max_rotations = p.max_rotations;
   ctx.times = nullptr;  // the caller times the whole check
@@ -83,12 +92,14 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   // Every trial must hold when min_share is 1: a pose's first failure ends its other trials.
   const int allowed = static_cast<int>(std::floor((1.0 - p.min_share) * kTrials + 1e-9));
   const V3 k1_O = toV3(Eigen::Vector3d(om.principal_axes.col(0)));
-  auto near = [&](const Rigid& X, int trial, double scale) {
+  // Hanging poses (supports finite): pendulums, whose trials swing (see below).
+  auto pendulum = [&](size_t i) { return i < supports.size() && supports[i].allFinite(); };
+  auto near = [&](const Rigid& X, int trial, double scale, double angle_scale = 0) {
     const size_t i = trial / kTrials;
     const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(X, om.com));
     const double moved = (c1 - c0).norm();
     if (moved > scale * p.end_distance) return false;
-    if (rotationAngle(X, X_GO[i]) <= scale * p.end_angle) return true;
+    if (rotationAngle(X, X_GO[i]) <= (angle_scale > 0 ? angle_scale : scale) * p.end_angle) return true;
     // Released at the pose with the centre of mass off, an object lying on its side that only
     // rolls about its long axis k1 to its heavier side stays where it was put (a marker's rest
     // roll moves tens of degrees for a millimetre of centre of mass): these trials also hold
@@ -117,9 +128,11 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
       if (failures[i] > allowed) continue;
       for (int k = 0; k < kTrials; ++k) {
         if (kPhaseOf[k] != phase) continue;
-        const Trial t = makeTrial(X_GO[i], k, om, extent[i], p);
+        const Eigen::Vector3d none = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+        const Trial t = makeTrial(X_GO[i], k, om, extent[i], p, i < supports.size() ? supports[i] : none);
         const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
-        stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax);
+        stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax,
+                        i < pegs.size() ? pegs[i] : PegLine{});
       }
     }
     while (!stepper.empty()) {
@@ -131,6 +144,15 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
       stepper.step(leaves);
       for (const TreeLeaf& l : leaves) {
         bool held = (l.stable || l.supported) && near(l.X_GO, l.root, 1.0);
+        // A hanging pose's trial holds when it still hangs, stable, with its centre of mass
+        // within end_distance of the pose's, whatever its turn (a pendulum's rest turns with its
+        // centre of mass: a ring with it moved off its middle spins to hang it lowest).
+        // Its centre of mass is the trial's (moved off in the centre-of-mass trials).
+        const size_t pose = l.root / kTrials;
+        if (!held && l.stable && l.hanging && pendulum(pose)) {
+          const Trial t = makeTrial(X_GO[pose], l.root % kTrials, om, extent[pose], p, supports[pose]);
+          held = (toEigen(apply(l.X_GO, t.com_O)) - toEigen(apply(X_GO[pose], om.com))).norm() <= p.end_distance;
+        }
         const int k = l.root % kTrials;
         if (!held && tilted_trials && p.recheck_caught && k >= 4 && k < 8 && l.stable &&
             l.tipping_angle >= p.caught_min_tip && rotationAngle(l.X_GO, X_GO[l.root / kTrials]) <= p.caught_angle &&
@@ -158,7 +180,9 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
       // with more failures than allowed is decided: its open trials stop.
       stepper.prune([&](const TreeNode& n) {
         const size_t i = n.root / kTrials;
-        if (failures[i] <= allowed && near(n.X_GO, n.root, 2.0)) return false;
+        // A hanging pose's trial swings (its rest turns with its centre of mass): pruned at twice
+        // the distance, its turn unbounded (a ring spins).
+        if (failures[i] <= allowed && near(n.X_GO, n.root, 2.0, pendulum(i) ? kPendulumTurn : 0)) return false;
         if (failures[i] <= allowed) {
           if (kTraceTrials)
             std::fprintf(stderr, "trial pose %zu k %d pruned turned %.2f\n", i, n.root % kTrials,
@@ -183,7 +207,7 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
         owner.push_back(static_cast<int>(r));
       }
   if (!ends.empty() && finished) {
-    const std::vector<Robustness> re = check(ends, ctx_in, p, keep_going, false);
+    const std::vector<Robustness> re = check(ends, ctx_in, p, keep_going, false, {}, {});
     for (size_t j = 0; j < ends.size(); ++j) {
       if (kTraceTrials)
         std::fprintf(stderr, "recheck at %.3f %.3f %.3f k %d held %d\n", X_GO[owner[j] / kTrials].t.x,
@@ -213,8 +237,10 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
 
 std::vector<Robustness> checkRobustness(const std::vector<Rigid>& X_GO, const TreeContext& ctx,
                                         const RobustnessParams& p,
-                                        const std::function<bool()>& keep_going) {
-  return check(X_GO, ctx, p, keep_going, true);
+                                        const std::function<bool()>& keep_going,
+                                        const std::vector<Eigen::Vector3d>& supports,
+                                        const std::vector<PegLine>& pegs) {
+  return check(X_GO, ctx, p, keep_going, true, supports, pegs);
 }
 
 }  // namespace place_planner

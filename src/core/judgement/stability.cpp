@@ -142,43 +142,73 @@ Eigen::Vector3d slipOf(const std::vector<ContactPoint>& contacts, const Eigen::V
                        ForceModelParams{prm.friction, 8, prm.max_load}, 1.0, true);
 }
 
-// Hanging: the forces balance gravity (the centre of mass straight below the support), and
-// friction holds gravity tilted by half the friction angle towards each of the 4 horizontal axis
-// directions (force rows only: the tilt's torque swings the object to a new rest, it does not
-// make it fall). A ring on a peg sloping down past atan mu slides off.
+// Hanging: the contact forces, inside their friction cones, balance gravity (the centre of mass
+// straight below the support). A ring on a peg sloping down past atan mu slides off.
 Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                            const StabilityParams& prm) {
   Stability r;
   r.hanging = true;
-  const ContactForces forces = forceModel(contacts, com, prm);
+  Eigen::Vector3d c = Eigen::Vector3d::Zero(), nbar = Eigen::Vector3d::Zero();
+  for (const auto& p : contacts) c += p.p_W, nbar += p.n_W;
+  c /= static_cast<double>(contacts.size());
+  // Hanging on one peg, the contacts lie on the peg's top under the loop: one support, whose
+  // normal is their mean. A contact's own normal blends the meshes' around it (sphereContact):
+  // where a flat bar rests on a faceted peg's ridge it leans towards the facet beside it (25
+  // to 45 degrees, past the friction cone), though the bar rests on the ridge. Contacts on
+  // surfaces facing different ways (a peg and a wall) keep their own.
+  std::vector<ContactPoint> support = contacts;
+  bool one_support = nbar.norm() > 1e-9;
+  for (const auto& p : contacts) one_support = one_support && p.n_W.dot(nbar.normalized()) >= 0.5;
+  if (one_support)
+    for (auto& p : support) p.n_W = nbar.normalized();
+  ContactForces forces = forceModel(support, com, prm);
   r.balanced = forces.balances(-kUp);
-  bool holds = r.balanced;
-  const double tilt = 0.5 * std::atan(prm.friction);
-  for (int k = 0; k < 4 && holds; ++k) {
-    const double phi = k * M_PI / 2;
-    holds = forces.balancesForce(Eigen::Vector3d(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi), -std::cos(tilt)));
+  // A pendulum rests where its centre of mass is straight below its support, which contacts
+  // within tol of touching locate only roughly: a centre of mass within tol, horizontally, of
+  // the segments between its contacts is at rest to the model's resolution (and to the swing's,
+  // whose drops onto the sphere lattice are uneven by tens of micrometres).
+  if (!r.balanced) {
+    const Eigen::Vector2d m = com.head<2>();
+    Eigen::Vector2d nearest = support.front().p_W.head<2>();
+    for (size_t i = 0; i < support.size(); ++i)
+      for (size_t j = i; j < support.size(); ++j) {
+        const Eigen::Vector2d a = support[i].p_W.head<2>(), e = support[j].p_W.head<2>() - a;
+        const double s = e.squaredNorm() > 1e-18 ? std::clamp((m - a).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+        if ((a + s * e - m).norm() < (nearest - m).norm()) nearest = a + s * e;
+      }
+    if ((nearest - m).norm() <= prm.tol) {
+      ContactForces shifted = forceModel(support, Eigen::Vector3d(nearest.x(), nearest.y(), com.z()), prm);
+      if (shifted.balances(-kUp)) {
+        r.balanced = true;
+        forces = std::move(shifted);
+      }
+    }
   }
+  // Equilibrium is the decision (gravity loads the contacts inside their friction cones); the
+  // margin a standing pose needs is the perturbed releases' here, each settled by the swing.
+  const bool holds = r.balanced;
   r.stable = holds;
   r.friction_ok = holds;
   r.com_inside = r.balanced;
   // Q: how far below its support the centre of mass hangs, against the support's spread (a
   // deep pendulum swings back from a push; one just under a wide support barely).
-  double top = -std::numeric_limits<double>::infinity(), reach = 1e-9;
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const auto& p : contacts) c += p.p_W;
-  c /= static_cast<double>(contacts.size());
-  for (const auto& p : contacts) {
-    top = std::max(top, p.p_W.z());
-    reach = std::max(reach, (p.p_W - c).norm());
-  }
+  double reach = 1e-9;
+  for (const auto& p : contacts) reach = std::max(reach, (p.p_W - c).norm());
   const Eigen::Vector3d off = com - c;
   // Its margin: the swing the support allows before the centre of mass comes level with it;
   // unstable, how far it is swung off straight below its support (negative: far off, over a
   // drop, the tree's fall cut ends it as it does an object going over a ledge).
   r.tipping_angle = holds ? std::atan2(-off.z(), reach) : -std::atan2(std::hypot(off.x(), off.y()), -off.z());
   r.quality = holds ? std::max(0.3, 1.0 - std::hypot(off.x(), off.y()) / reach) : -1.0;
+  // Where friction alone fails (a loop on a round peg's shoulder: wide cones would hold it),
+  // it slides round the peg, towards straight below it, before any swing.
+  const Eigen::Vector3d slip = holds || r.balanced ? Eigen::Vector3d::Zero() : slipOf(support, com, prm);
   if (holds) {
     r.failure = Failure::kNone;
+  } else if (slip.norm() > 0) {
+    r.failure = Failure::kSlide;
+    r.slips = true;
+    r.d_f = slip;
   } else {
     // It swings: towards its centre of mass's side, about the support.
     r.failure = Failure::kTip;

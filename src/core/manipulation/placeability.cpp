@@ -56,32 +56,42 @@ bool gripperTiltOk(const Eigen::Matrix3d& R_GO, const PlannerConfig& config) {
   return z_F.dot(-Eigen::Vector3d::UnitZ()) >= std::cos(config.max_gripper_tilt_deg * M_PI / 180.0) - 1e-9;
 }
 
-Placement checkPlacement(const TreeLeaf& leaf, const PlaceabilityContext& ctx) {
+Placement checkPlacement(const TreeLeaf& leaf, const PlaceabilityContext& ctx, const HangingStart* hanging) {
   const PlannerConfig& cfg = ctx.config;
   const Eigen::Matrix3d R_WG = ctx.am.R_GW.transpose();
-  const Eigen::Vector3d d = toEigen(ctx.d_vis);
-  const double D = cfg.approach_distance;
+  const Eigen::Vector3d d = hanging ? hanging->approach : toEigen(ctx.d_vis);
+  const double D = hanging ? hanging->approach_distance : cfg.approach_distance;
   Placement out;
   out.checked = true;
-  // The object swept straight along d_vis into the goal: free when its first contact (the
-  // distance kernel, V-A) is the goal itself (within 0.5 mm).
   Eigen::Isometry3d goal = toIsometry(leaf.X_GO);
   Eigen::Isometry3d pre = goal;
-  pre.translation() -= D * d;
-  std::vector<double> t;
-  ctx.backend.distance({TranslationQuery{toRigid(pre), ctx.d_vis, D + 0.01}}, t);
-  out.straight = t[0] >= D - 1e-3;
   Eigen::Isometry3d end = goal;  // where the straight approach ends
-  if (!out.straight && leaf.path.size() >= 2) {
-    end = toIsometry(leaf.path[1]);  // after the first contact translation: free by construction
+  if (hanging) {
+    // Threaded along the peg to the first pose of the path (its sweep was checked free by
+    // hangingStarts), then lowered onto the peg.
+    out.straight = false;
+    end = toIsometry(leaf.path.front());
     pre = end;
     pre.translation() -= D * d;
+  } else {
+    // The object swept straight along d_vis into the goal: free when its first contact (the
+    // distance kernel, V-A) is the goal itself (within 0.5 mm).
+    pre.translation() -= D * d;
+    std::vector<double> t;
+    ctx.backend.distance({TranslationQuery{toRigid(pre), ctx.d_vis, D + 0.01}}, t);
+    out.straight = t[0] >= D - 1e-3;
+    if (!out.straight && leaf.path.size() >= 2) {
+      end = toIsometry(leaf.path[1]);  // after the first contact translation: free by construction
+      pre = end;
+      pre.translation() -= D * d;
+    }
   }
-  out.approach = LinearMotion{R_WG * d, cfg.approach_min_distance, D, D};
+  out.approach = LinearMotion{R_WG * d, std::min(cfg.approach_min_distance, D), D, D};
   out.pre_place_W = Eigen::Isometry3d::Identity();
   out.pre_place_W.linear() = R_WG * pre.linear();
   out.pre_place_W.translation() = R_WG * pre.translation();
-  if (cfg.min_edge_clearance > 0 && !edgeClear(ctx.om, ctx.am, leaf.X_GO, cfg.min_edge_clearance)) {
+  // A drop-off around a hanging object is where it hangs, not an edge to keep from.
+  if (!hanging && cfg.min_edge_clearance > 0 && !edgeClear(ctx.om, ctx.am, leaf.X_GO, cfg.min_edge_clearance)) {
     out.blocked = "edge";
     return out;
   }

@@ -31,8 +31,9 @@ std::vector<V3> orderFloorPoints(const std::vector<V3>& points, double spacing) 
 }
 
 RootSearch::RootSearch(const std::vector<V3>& floor_points_G, const std::vector<StartOrientation>& orientations,
-                       const MeshProperties& object, const AreaModel& area, const V3& d_vis_G)
-    : floor_points_(floor_points_G), orientations_(orientations), com_O_(object.center_of_mass),
+                       const MeshProperties& object, const AreaModel& area, const V3& d_vis_G,
+                       std::vector<HangingStart> hanging)
+    : hanging_(std::move(hanging)), floor_points_(floor_points_G), orientations_(orientations), com_O_(object.center_of_mass),
       radius_(object.bounding_radius), d_vis_(d_vis_G) {
   hmax_ = -kInf;
   hmin_ = kInf;
@@ -46,8 +47,19 @@ double RootSearch::clearance(int root) const {
   return hmax_ + dot(floor_points_[floorPoint(root)], d_vis_) + radius_ + 0.01;
 }
 
+V3 RootSearch::floorPointG(int root) const {
+  if (const HangingStart* h = hanging(root)) return toV3(h->peg_point);
+  return floor_points_[floorPoint(root)];
+}
+
+StartKind RootSearch::kind(int root) const {
+  if (hanging(root)) return StartKind::kLoopOnPeg;
+  return orientations_[(root - hangingCount()) % orientations_.size()].kind;
+}
+
 Rigid RootSearch::pose(int root) const {
-  const Eigen::Matrix3d& R = orientations_[root % orientations_.size()].R_GO;
+  if (const HangingStart* h = hanging(root)) return h->X_GO;
+  const Eigen::Matrix3d& R = orientations_[(root - hangingCount()) % orientations_.size()].R_GO;
   const Eigen::Vector3d com_G = toEigen(floor_points_[floorPoint(root)]) - clearance(root) * toEigen(d_vis_);
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = R;
@@ -55,7 +67,10 @@ Rigid RootSearch::pose(int root) const {
   return toRigid(X);
 }
 
-double RootSearch::tmax(int root) const { return clearance(root) + radius_ + (hmax_ - hmin_) + 0.01; }
+double RootSearch::tmax(int root) const {
+  if (const HangingStart* h = hanging(root)) return h->drop;
+  return clearance(root) + radius_ + (hmax_ - hmin_) + 0.01;
+}
 
 }  // namespace place_planner
 
@@ -69,7 +84,9 @@ void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O,
   for (int step = 0, target = first_batch;; ++step) {
     if (step > 0 && step % 2 == 0) target = std::min(batch, 2 * target);
     while (static_cast<int>(stepper.active()) < target && next < roots.size()) {
-      stepper.addRoot(roots.pose(next), next, com_O, roots.d_vis(), roots.tmax(next));
+      const HangingStart* h = roots.hanging(next);
+      stepper.addRoot(roots.pose(next), next, com_O, roots.direction(next), roots.tmax(next),
+                      h ? PegLine{h->peg_point, -h->approach} : PegLine{});
       ++next;
     }
     if (stepper.empty()) break;

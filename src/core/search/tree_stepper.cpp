@@ -26,6 +26,8 @@ const bool kTrace = std::getenv("PP_TRACE") != nullptr;
 constexpr double kSmallTurn = 2.0 * M_PI / 180.0;
 constexpr int kMaxTurnsPerRotation = 4;
 constexpr int kMaxRocks = 8;  // rock settle steps per tree
+constexpr int kMaxSwings = 40;
+constexpr double kSwingDrop = 1e-6;  // m  // swing steps per tree (swingStep: 5 halvings and the moves between)
 // Roll settle: coarse roll steps searched each way, their size, the fine steps refining a
 // bottom within a coarse step either side, and the steepest roll axis.
 constexpr int kRollSteps = 8;
@@ -150,8 +152,10 @@ Rigid rotatedAbout(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector
 
 TreeStepper::TreeStepper(const TreeContext& ctx) : ctx_(ctx), diag_(norm(ctx.am.bounds.hi - ctx.am.bounds.lo)) {}
 
-void TreeStepper::addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax) {
+void TreeStepper::addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax,
+                          const PegLine& peg) {
   TreeNode n;
+  n.peg = peg;
   n.X_GO = X_GO;
   n.root = root;
   n.com_O = com_O;
@@ -163,7 +167,7 @@ void TreeStepper::addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3
 
 std::vector<int> TreeStepper::openRoots() const {
   std::vector<int> open;
-  for (const auto* list : {&translate_, &contact_, &rotating_, &rolling_, &rocking_})
+  for (const auto* list : {&translate_, &contact_, &rotating_, &rolling_, &rocking_, &swinging_})
     for (const TreeNode& n : *list) open.push_back(n.root);
   std::sort(open.begin(), open.end());
   open.erase(std::unique(open.begin(), open.end()), open.end());
@@ -171,7 +175,7 @@ std::vector<int> TreeStepper::openRoots() const {
 }
 
 void TreeStepper::prune(const std::function<bool(const TreeNode&)>& drop) {
-  for (auto* list : {&translate_, &contact_, &rotating_, &rolling_, &rocking_})
+  for (auto* list : {&translate_, &contact_, &rotating_, &rolling_, &rocking_, &swinging_})
     list->erase(std::remove_if(list->begin(), list->end(), drop), list->end());
 }
 
@@ -181,6 +185,7 @@ void TreeStepper::step(std::vector<TreeLeaf>& leaves) {
   if (!rotating_.empty()) tiltStep(leaves);
   if (!rolling_.empty()) rollStep();
   if (!rocking_.empty()) rockStep(leaves);
+  if (!swinging_.empty()) swingStep();
 }
 
 // ---------------------------------------------------------------- first contact (V-A)
@@ -238,6 +243,8 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
                                         s.tipping_angle >= ctx_.stability.min_tipping_angle);
     auto leaf = [&](bool stable, bool at_rest) {
       leaves.push_back(TreeLeaf{n.X_GO, n.root, stable, at_rest, supported, s.quality, s.tipping_angle, n.contacts, n.path});
+      leaves.back().hanging = s.hanging;
+      leaves.back().peg = n.peg;
     };
     n.quality = s.quality;
     n.tipping_angle = s.tipping_angle;
@@ -306,7 +313,9 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
         leaf(false, true);
       }
     };
-    if (s.hanging && s.stable) {
+    if (s.hanging && n.peg.known() && !n.swung && n.swings < kMaxSwings && !falls) {
+      swinging_.push_back(std::move(n));  // threaded on a peg: to the pendulum's rest first
+    } else if (s.hanging && s.stable) {
       leaf(true, true);  // hanging at the bottom of its swing (on a point or a line, too)
     } else if (falls) {
       TreeLeaf l{n.X_GO, n.root, false, true, supported, s.quality, s.tipping_angle, n.contacts, n.path};
@@ -343,6 +352,80 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
   addTime(ctx_.times ? &ctx_.times->stability : nullptr, t0);
 }
 
+// ---------------------------------------------------------------- the swing (beyond the paper)
+// A hanging object comes to rest where its centre of mass is lowest: a pendulum's rest, found
+// by descent. Each step tries the object turned both ways about two horizontal axes through the
+// middle of its contacts (a swing, and the roll of a loop on its peg) and, on a known peg, moved
+// both ways across the peg (a loop sliding over it), each lowered back onto the support (V-A's
+// translation); it takes the move that lowers the centre of mass most, or halves the step when
+// none does, from kSwingStart down to kSwingEnd. Along the peg friction decides (the stability
+// test's tilted gravity), so it is not a move. The exact rotation to
+// the next contact (V-C.2) does not serve here: a loop's own contacts, within a collision
+// distance of the peg all round it, stop a turn after a fraction of a degree.
+void TreeStepper::swingStep() {
+  const auto t0 = Clock::now();
+  constexpr double kSwingStart = 4.0 * M_PI / 180.0, kSwingEnd = 0.25 * M_PI / 180.0;
+  // None; turns both ways about the two horizontal axes (along and across the peg) through the
+  // contacts' middle, and about the peg's axis; slides both ways across the peg.
+  constexpr int kMoves = 1 + 2 * 2 + 2 + 2;
+  const double gap = 0.5 * ctx_.cd;
+  std::vector<TranslationQuery> q;
+  q.reserve(swinging_.size() * kMoves);
+  for (TreeNode& n : swinging_) {
+    if (n.swing_step <= 0) n.swing_step = kSwingStart;
+    Eigen::Vector3d mid = Eigen::Vector3d::Zero();
+    for (const ContactPoint& c : n.contacts) mid += c.p_W;
+    mid /= static_cast<double>(std::max<size_t>(1, n.contacts.size()));
+    double reach = ctx_.cd;  // how far the contacts spread about the middle: what may dig in
+    for (const ContactPoint& c : n.contacts) reach = std::max(reach, (c.p_W - mid).norm() + ctx_.cd);
+    const Eigen::Vector3d com = toEigen(apply(n.X_GO, n.com_O));
+    const double depth = std::max(mid.z() - com.z(), ctx_.cd);
+    const double t = n.swing_step;
+    // Horizontal axes along and across the peg (swingStep runs on known pegs only).
+    const Eigen::Vector3d along = Eigen::Vector3d(n.peg.axis.x(), n.peg.axis.y(), 0).normalized();
+    const Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(along);
+    auto push = [&](const Rigid& Y0, double lift) {
+      Rigid Y = Y0;
+      Y.t = Y.t + v3(0, 0, lift);
+      q.push_back(TranslationQuery{Y, v3(0, 0, -1), lift + gap + 0.01});
+    };
+    push(n.X_GO, gap);
+    for (const Eigen::Vector3d& axis : {along, across})
+      for (const double sign : {1.0, -1.0}) push(rotatedAbout(n.X_GO, mid, axis, sign * t), gap + reach * t);
+    // Round the peg's axis: the loop slides round the peg (its contact moves over the peg).
+    for (const double sign : {1.0, -1.0}) push(rotatedAbout(n.X_GO, n.peg.point, n.peg.axis, sign * t), gap + reach * t);
+    for (const double sign : {1.0, -1.0}) push(translated(n.X_GO, toV3(sign * t * depth * across)), gap);
+  }
+  std::vector<double> d;
+  ctx_.backend.distance(q, d);
+  for (size_t i = 0; i < swinging_.size(); ++i) {
+    TreeNode& n = swinging_[i];
+    int best = 0;
+    double h[kMoves];
+    for (int k = 0; k < kMoves; ++k) {
+      const TranslationQuery& tq = q[i * kMoves + k];
+      const double dk = d[i * kMoves + k];
+      h[k] = dk >= kInf || dk >= tq.tmax ? kInf : apply(tq.X_GO, n.com_O).z - dk;
+      if (h[k] < h[best]) best = k;
+    }
+    ++n.swings;
+    // A move counts when it lowers the centre of mass by a micrometre: at the last step (0.25
+    // degrees) a centre of mass 1 mm off under a 6 cm pendulum drops 4 micrometres.
+    if (best != 0 && h[best] < h[0] - kSwingDrop) {
+      n.X_GO = translated(q[i * kMoves + best].X_GO, v3(0, 0, -d[i * kMoves + best]));
+      n.path.push_back(n.X_GO);
+      ++n.turns;
+    } else {
+      n.swing_step *= 0.5;
+      if (h[0] < kInf) n.X_GO = translated(q[i * kMoves].X_GO, v3(0, 0, -d[i * kMoves]));
+      n.swung = n.swing_step < kSwingEnd;
+    }
+    contact_.push_back(std::move(n));
+  }
+  swinging_.clear();
+  addTime(ctx_.times ? &ctx_.times->tilt_vertex : nullptr, t0);
+}
+
 // ---------------------------------------------------------------- tilt angles (V-C.2)
 // Exact angles to the next contact, vertex/surface and edge/edge, in both directions.
 void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
@@ -376,9 +459,9 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
     // Directions a contact blocks, or not asked for, are not searched (limit 0).
     if (blocked(n.contacts, n.s_A, n.d_A, 1, 1.5 * ctx_.cd)) rq.limit_ccw = 0;
     if (!n.both_directions || blocked(n.contacts, n.s_A, n.d_A, -1, 1.5 * ctx_.cd)) rq.limit_cw = 0;
-    // The swing (beyond the paper): a hanging object turns about its support until its centre
-    // of mass is straight below the axis, unless a contact stops it first. Its lever's height
-    // after a turn t is A cos t + B sin t, lowest at t* = atan2(-B, -A).
+    // The swing (beyond the paper) of an object hanging off no known peg: it turns about its
+    // support until its centre of mass is straight below the axis, unless a contact stops it
+    // first. Its lever's height after a turn t is A cos t + B sin t, lowest at t* = atan2(-B, -A).
     swing.push_back({kInf, kInf});
     if (n.hanging && lev.norm() > 1e-9) {
       const double A = lev.z(), B = n.d_A.cross(lev).z();
@@ -647,6 +730,7 @@ void TreeStepper::rockStep(std::vector<TreeLeaf>& leaves) {
       // Rocked down between steep contacts facing each other, it hangs in a V of edges.
       const bool wedged = n.rocks > 0 && hangsBetweenEdges(n.contacts);
       leaves.push_back(TreeLeaf{n.X_GO, n.root, n.held && !wedged, true, n.supported && !wedged, n.quality, n.tipping_angle, n.contacts, n.path});
+      leaves.back().hanging = n.hanging;
       continue;
     }
     if (kTrace) std::fprintf(stderr, "root %d rocks %d by %.1f um\n", n.root, best, (h[0] - h[best]) * 1e6);

@@ -1,0 +1,30 @@
+// Hanging roots (beyond the paper): an object threaded by one of its loops onto one of the
+// area's pegs, clear of both, from where the tree's first translation (along gravity, V-A)
+// lowers the loop onto the peg and the swing (tree_stepper.cpp) brings it to rest. Frame G.
+#pragma once
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "place_planner/infra/backend.h"
+#include "place_planner/model/scene.h"
+#include "place_planner/search/loops.h"
+#include "place_planner/search/pegs.h"
+
+namespace place_planner {
+
+struct HangingStart {
+  Rigid X_GO;                  // threaded: the peg through the loop's middle, touching nothing
+  double drop = 0;             // m: the translation along -z that lowers the loop onto the peg
+  Eigen::Vector3d approach;    // G, unit: the threading motion, along the peg towards its base
+  double approach_distance = 0;  // m: from wholly beyond the tip to the threaded pose, checked free
+  Eigen::Vector3d peg_point;   // G: where on the peg (reported as the candidate's floor point)
+};
+
+// For each peg (in order) and each loop wide enough for it, both ways round the peg: the loop's
+// axis along the peg, turned about it so that the centre of mass hangs below the loop, and far
+// enough along the peg that the object clears the peg's base. Kept when the object's sphere
+// model sweeps along the peg from beyond its tip to that pose without touching the area.
+std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,
+                                        const ObjectModel& om, Backend& backend, double collision_distance);
+
+}  // namespace place_planner

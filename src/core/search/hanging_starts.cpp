@@ -1,0 +1,70 @@
+// Hanging roots (hanging_starts.h).
+#include "place_planner/search/hanging_starts.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace place_planner {
+
+std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,
+                                        const ObjectModel& om, Backend& backend, double cd) {
+  std::vector<HangingStart> starts;
+  std::vector<TranslationQuery> sweeps;
+  const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d com_O = toEigen(om.com);
+  for (const Peg& peg : pegs)
+    for (const Loop& loop : loops) {
+      // The loop must go round the peg (the sweep below checks it with the sphere models).
+      if (loop.radius < peg.half_width + 0.001) continue;
+      const Eigen::Vector3d hang = (down - down.dot(peg.axis) * peg.axis).normalized();  // down, across the peg
+      Eigen::Vector3d below = com_O - loop.centre;
+      below -= below.dot(loop.axis) * loop.axis;
+      if (below.norm() < 1e-6) below = loop.axis.unitOrthogonal();  // a ring: any way round
+      below.normalize();
+      for (const double sign : {1.0, -1.0}) {
+        // R takes the loop's axis to the peg's (either way) and `below` to straight down across it.
+        Eigen::Matrix3d from, to;
+        from << loop.axis, below, loop.axis.cross(below);
+        to << sign * peg.axis, hang, (sign * peg.axis).cross(hang);
+        const Eigen::Matrix3d R = to * from.transpose();
+        // How far the object reaches from the loop's centre towards the base and towards the tip.
+        double back = 0, front = 0;
+        for (const V3& v : om.vertices) {
+          const double s = (R * (toEigen(v) - loop.centre)).dot(peg.axis);
+          back = std::max(back, -s);
+          front = std::max(front, s);
+        }
+        // Along the peg: in the middle of the room between the object clear of the base (by a
+        // collision distance and a millimetre) and the loop a thickness short of the tip, so a
+        // swing or a push meets neither.
+        const double length = peg.to_base + peg.to_tip;
+        const double nearest = back + cd + 0.001, farthest = length - loop.thickness;
+        if (nearest > farthest) continue;
+        const double along = 0.5 * (nearest + farthest);
+        const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis;
+        Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+        X.linear() = R;
+        X.translation() = at - R * loop.centre;
+        HangingStart h;
+        h.X_GO = toRigid(X);
+        h.drop = 2 * om.bounding_radius;  // its first contact ends it (V-A), below the opening's top
+        h.approach = -peg.axis;
+        h.approach_distance = (length - along) + back + 0.01;
+        h.peg_point = at;
+        Eigen::Isometry3d pre = X;
+        pre.translation() += h.approach_distance * peg.axis;
+        sweeps.push_back(TranslationQuery{toRigid(pre), toV3(h.approach), h.approach_distance + 0.01});
+        starts.push_back(h);
+      }
+    }
+  if (starts.empty()) return starts;
+  // Threaded by the sweep: its first contact (V-A's distance kernel) is past the threaded pose.
+  std::vector<double> t;
+  backend.distance(sweeps, t);
+  std::vector<HangingStart> free;
+  for (size_t i = 0; i < starts.size(); ++i)
+    if (t[i] >= starts[i].approach_distance + 1e-3) free.push_back(starts[i]);
+  return free;
+}
+
+}  // namespace place_planner

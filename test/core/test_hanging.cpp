@@ -1,0 +1,96 @@
+// Hanging (beyond the paper): the area's pegs (search/pegs.h), the object's loops
+// (search/loops.h), and the choice of placement kind (config.h PlacementKind).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "place_planner/infra/scenes.h"
+#include "place_planner/model/scene.h"
+#include "place_planner/planner.h"
+#include "place_planner/search/loops.h"
+#include "place_planner/search/pegs.h"
+
+namespace place_planner {
+namespace {
+
+std::vector<Peg> pegsOf(const Mesh& area) {
+  const AreaModel am = buildAreaModel(area, Eigen::Vector3d(0, 0, -1), 0.002, 0.004, 0.004);
+  return findPegs(am);
+}
+
+double degrees(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
+}
+
+TEST(Pegs, CoatPegsAndAMugTreesArmsAreFoundTablesAndShelvesAreNot) {
+  // Six pegs 10 cm long rising 5 degrees towards -y: each once, its axis along it, to its tip.
+  const std::vector<Peg> wall = pegsOf(scenes::pegWall(5.0));
+  ASSERT_EQ(wall.size(), 6u);
+  for (const Peg& p : wall) {
+    EXPECT_LT(degrees(p.axis, Eigen::Vector3d(0, -std::cos(5 * M_PI / 180), std::sin(5 * M_PI / 180))), 4.0);
+    EXPECT_NEAR(p.to_tip + p.to_base, 0.10, 0.01);
+    EXPECT_NEAR(p.half_width, 0.006, 0.002);
+    const Eigen::Vector3d tip = p.point + p.to_tip * p.axis;
+    EXPECT_NEAR(tip.y(), 0.092 - 0.1 * std::cos(5 * M_PI / 180), 0.006);
+  }
+  // The mug tree's four arms rise 25 degrees.
+  const std::vector<Peg> tree = pegsOf(scenes::mugTree());
+  ASSERT_EQ(tree.size(), 4u);
+  for (const Peg& p : tree) EXPECT_NEAR(std::asin(p.axis.z()) * 180 / M_PI, 25.0, 4.0);
+  // Boards, table tops, binders and upright rack pegs are no pegs.
+  EXPECT_TRUE(pegsOf(scenes::table()).empty());
+  EXPECT_TRUE(pegsOf(scenes::shelfUnit(4)).empty());
+  EXPECT_TRUE(pegsOf(scenes::binderStack()).empty());
+  EXPECT_TRUE(pegsOf(scenes::dishRack()).empty());
+}
+
+TEST(Loops, AHandlesOpeningAndARingsHoleAreFoundSolidsHaveNone) {
+  // The loop mug's handle: an opening 5.8 cm tall and 2.4 cm deep, through y.
+  const std::vector<Loop> mug = findLoops(scenes::loopMug());
+  ASSERT_FALSE(mug.empty());
+  EXPECT_LT(std::min(degrees(mug[0].axis, Eigen::Vector3d::UnitY()), degrees(mug[0].axis, -Eigen::Vector3d::UnitY())), 10.0);
+  EXPECT_NEAR(mug[0].radius, 0.012, 0.002);
+  EXPECT_GT(mug[0].centre.x(), 0.04);
+  EXPECT_LT(mug[0].centre.x(), 0.064);
+  EXPECT_NEAR(mug[0].centre.y(), 0.0, 0.005);
+  // A ring 6 cm across: its hole, 2.4 cm in radius, about z.
+  const std::vector<Loop> ring = findLoops(scenes::torus(0.03, 0.006));
+  ASSERT_EQ(ring.size(), 1u);
+  EXPECT_LT(degrees(ring[0].axis, Eigen::Vector3d::UnitZ()), 10.0);
+  EXPECT_NEAR(ring[0].radius, 0.024, 0.002);
+  EXPECT_LT(ring[0].centre.norm(), 0.002);
+  // No opening through a cube, a plate, a pen, or the mug whose handle is a solid block.
+  for (const char* name : {"cube", "plate", "pen", "mug"}) EXPECT_TRUE(findLoops(scenes::byName(name)).empty()) << name;
+}
+
+// The choice of placement kind: standing only drops the hanging poses; hanging only on a table
+// says why nothing hangs; the mug's best pose on a table is the same with any kind allowed.
+TEST(Placement, KindChoosesStandingOrHanging) {
+  const Mesh ring = scenes::torus(0.03, 0.006);
+  PlannerConfig c;
+  c.threads = 2;
+  c.placement = PlacementKind::kStanding;
+  const PlanResult standing = Planner().plan(ring, scenes::pegWall(), c);
+  EXPECT_EQ(standing.stats.pegs, 0);  // not searched
+  for (const Candidate& k : standing.candidates) EXPECT_FALSE(k.hanging);
+  c.placement = PlacementKind::kHanging;
+  const PlanResult hanging = Planner().plan(ring, scenes::pegWall(), c);
+  ASSERT_GT(hanging.stableCount(), 0);
+  for (const Candidate& k : hanging.candidates) EXPECT_TRUE(k.hanging);
+  const PlanResult none = Planner().plan(scenes::mug(), scenes::table(), c);
+  EXPECT_EQ(none.stableCount(), 0);
+  bool said = false;
+  for (const std::string& w : none.warnings) said = said || w.find("nothing to hang on") != std::string::npos;
+  EXPECT_TRUE(said);
+  c.placement = PlacementKind::kStanding;
+  const PlanResult table_standing = Planner().plan(scenes::mug(), scenes::table(), c);
+  c.placement = PlacementKind::kAny;
+  const PlanResult table_any = Planner().plan(scenes::mug(), scenes::table(), c);
+  ASSERT_GT(table_any.stableCount(), 0);
+  EXPECT_TRUE(table_any.candidates.front().X_WO.isApprox(table_standing.candidates.front().X_WO, 1e-9));
+  EXPECT_THROW(placementKindFromString("dangling"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace place_planner

@@ -1,0 +1,105 @@
+// Hanging placements (search/pegs.h, search/loops.h, search/hanging_starts.h) planned with
+// default options and checked in the Bullet validator.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/scenes.h"
+#include "place_planner/planner.h"
+#include "place_planner/validation/mesh_variants.h"
+#include "place_planner/validation/physics_validator.h"
+#include "validation_test_helpers.h"
+
+namespace place_planner {
+namespace validation {
+namespace {
+
+// A pendulum swings for long undamped: light damping, as air and the joint give it.
+ValidatorConfig damped() {
+  ValidatorConfig v;
+  v.linear_damping = 0.3;
+  v.angular_damping = 0.3;
+  v.settle_time = 3.0;
+  return v;
+}
+
+PlannerConfig twoThreads() {
+  PlannerConfig c;
+  c.threads = 2;
+  return c;
+}
+
+// The best candidate hangs, threaded along its peg towards the wall (+y), from a loop-on-peg root.
+void expectHangsOnAPeg(const Mesh& object, const PlanResult& r) {
+  ASSERT_FALSE(r.candidates.empty());
+  const Candidate& best = r.candidates.front();
+  ASSERT_TRUE(best.stable) << "no stable candidate";
+  EXPECT_TRUE(best.hanging);
+  EXPECT_EQ(best.start, StartKind::kLoopOnPeg);
+  EXPECT_GT(best.placement.approach.direction.y(), 0.95) << "not threaded along the peg";
+  EXPECT_FALSE(best.placement.straight);
+  // The pre-place pose is beyond the peg's tip (the pegs end at y = -0.01), on the peg's line.
+  EXPECT_LT(best.placement.pre_place_W.translation().y(), best.X_WO.translation().y() - 0.05);
+  // Every contact is above the centre of mass, which hangs within 5 mm of straight below them.
+  const Eigen::Vector3d com = best.X_WO * object.properties.center_of_mass;
+  Eigen::Vector3d mid = Eigen::Vector3d::Zero();
+  for (const ContactPoint& c : best.contacts) {
+    EXPECT_GT(c.p_W.z(), com.z() + 0.01);
+    mid += c.p_W / static_cast<double>(best.contacts.size());
+  }
+  EXPECT_LT((mid - com).head<2>().norm(), 0.005);
+}
+
+// A ring 6 cm across on the wall of coat pegs, nothing to stand on: it hangs by its hole, and
+// Bullet keeps it there (released 2 mm above, damped).
+TEST(Hanging, RingOnAWallOfPegsHangsAndStays) {
+  const Mesh ring = scenes::byName("ring");
+  const Mesh wall = scenes::pegWall();
+  const PlanResult r = Planner().plan(ring, wall, twoThreads());
+  EXPECT_EQ(r.stats.pegs, 6);
+  EXPECT_EQ(r.stats.loops, 1);
+  expectHangsOnAPeg(ring, r);
+  if (r.candidates.empty() || !r.candidates.front().stable) return;
+  const Candidate& best = r.candidates.front();
+  // Its centre (the centre of mass) hangs 2.4 cm, its inner radius, under its contact on the peg.
+  double top = -1;
+  for (const ContactPoint& c : best.contacts) top = std::max(top, c.p_W.z());
+  EXPECT_NEAR(top - best.X_WO.translation().z(), 0.024, 0.003);
+  // Bullet keeps it hanging: its centre within 1 cm of the goal's, still under the peg. Its
+  // turn is free: hung on a round peg through a hole four times as wide, a ring rests spun about
+  // its axis or twisted about the vertical as well (a neutral family; Bullet's lands 20-30
+  // degrees round it), so the validator's 5 degrees for a standing pose do not apply.
+  const PoseCheck p = PhysicsValidator(ring, wall, damped()).check(best.X_WO);
+  EXPECT_LT(p.moved_m, 0.01) << "Bullet: the ring moved " << 1000 * p.moved_m << " mm";
+  EXPECT_NEAR(p.X_WO_final.translation().z(), best.X_WO.translation().z(), 0.005) << "Bullet: the ring dropped";
+}
+
+// The YCB mug on the wall of pegs: the best candidate hangs by its handle.
+TEST(Hanging, MugOnAWallOfPegsHangsByItsHandle) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const PlanResult r = Planner().plan(mug, scenes::pegWall(), twoThreads());
+  EXPECT_EQ(r.stats.pegs, 6);
+  expectHangsOnAPeg(mug, r);
+}
+
+// Scanned input: the same mug with 10 % of its surface punched out still hangs by its handle.
+TEST(Hanging, MugWithHolesStillHangs) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = punchHoles(loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply"), 0.10, 7);
+  const PlanResult r = Planner().plan(mug, scenes::pegWall(), twoThreads());
+  expectHangsOnAPeg(mug, r);
+}
+
+TEST(Hanging, MugHangingOnAPegStaysInBullet) {
+  GTEST_SKIP() << "the validator's convex pieces (40 degrees, 32 triangles) close the YCB mug's handle, so "
+                  "Bullet pushes the mug off the peg (moved 5-8 cm); with finer pieces (15 degrees, 8 "
+                  "triangles) it stays on the peg (moved 3 mm) but turns 15-25 degrees to a rest of its "
+                  "own (doc/validation.md, \"Hanging\")";
+}
+
+}  // namespace
+}  // namespace validation
+}  // namespace place_planner

@@ -216,6 +216,7 @@ void toMsg(const Candidate& c, const std::string& frame_id, const std::string& g
   msg->robust_trials = c.robustness.trials;
   msg->min_tipping_angle = c.robustness.min_tipping_angle;
   msg->start = toString(c.start);
+  msg->kind = c.hanging ? "hanging" : "standing";
   msg->physics_checked = c.physics.checked;
   msg->physics_stayed = c.physics.stayed;
   msg->physics_moved = c.physics.moved_m;

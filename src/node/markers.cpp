@@ -126,8 +126,8 @@ visualization_msgs::MarkerArray buildMarkers(const Mesh& object_O, const Mesh& a
       text.scale.z = 0.03;  // text height
       setColour(&text, 1.0f, 1.0f, 1.0f, 1.0f);
       char buf[96];
-      std::snprintf(buf, sizeof buf, "#%d Q=%.2f push=%.2f%s%s", i + 1, c.quality, c.push_resistance_mean,
-                    c.stable ? "" : " (unstable)",
+      std::snprintf(buf, sizeof buf, "#%d%s Q=%.2f push=%.2f%s%s", i + 1, c.hanging ? " hanging" : "", c.quality,
+                    c.push_resistance_mean, c.stable ? "" : " (unstable)",
                     c.support == SupportKind::kSeen ? "" : c.support == SupportKind::kCompleted ? " (on unseen: completed)"
                                                                                                  : " (on unseen: area border)");
       text.text = buf;

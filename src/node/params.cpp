@@ -285,11 +285,14 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("retreat_min_distance", &p.retreat_min_distance);
   std::string rank_order = rankOrderName(p.rank_order);
   r.read("rank_order", &rank_order);
+  std::string placement = toString(p.placement);
+  r.read("placement", &placement);
   r.read("prefer_near", &p.prefer_near);
   r.read("min_edge_clearance", &p.min_edge_clearance);
   r.read("scan_noise", &p.scan_noise);
   try {
     p.rank_order = rankOrderFromName(rank_order);
+    p.placement = placementKindFromString(placement);
     p.orientation = orientationModeFromString(orientation);
     p.backend = backendFromString(backend);
     validate(p);  // "friction = -0.1 is out of range (...)"

@@ -230,6 +230,7 @@ PreparedGoal prepareGoal(const PlacePlanGoal& goal, const TopicMeshes& topics,
   try {
     if (!goal.orientation_mode.empty()) c.orientation = orientationModeFromString(goal.orientation_mode);
     if (!goal.rank_order.empty()) c.rank_order = rankOrderFromName(goal.rank_order);
+    if (!goal.placement.empty()) c.placement = placementKindFromString(goal.placement);
     validate(c);  // names the field: "friction = -1 is out of range (...)"
   } catch (const std::invalid_argument& e) {
     throw GoalError(Result::INVALID_GOAL, std::string("goal: ") + e.what());

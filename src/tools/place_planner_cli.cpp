@@ -29,6 +29,7 @@
 #include "place_planner/infra/scenes.h"
 #ifdef PLACE_PLANNER_HAVE_VALIDATION
 #include "place_planner/validation/physics_validator.h"
+#include "place_planner/validation/plot.h"
 #endif
 
 using namespace place_planner;
@@ -395,6 +396,7 @@ int main(int argc, char** argv) {
   int json_fd = -1;  // --json -: the original standard output
   bool auto_gravity = false, no_robust_check = false;
   int verify_k = 0;
+  std::string picture_path;
 
   app.add_option("--object", object_spec, "object mesh (its own frame O): file or builtin:NAME")
       ->required();
@@ -456,6 +458,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(backends))
       ->capture_default_str()
       ->type_name("NAME");
+  app.add_option("--picture", picture_path,
+                 "draw the best candidate in the area with its approach (PNG), seen from the approach's side");
   app.add_option("--verify", verify_k, "physics check of the best K stable candidates, 0 = off")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
@@ -561,6 +565,7 @@ int main(int argc, char** argv) {
     if (no_robust_check) c.robust_check = false;
 #ifndef PLACE_PLANNER_HAVE_VALIDATION
     if (verify_k > 0) throw InputError("--verify: built without Bullet (no validation library)");
+    if (!picture_path.empty()) throw InputError("--picture: built without the validation library (OpenCV)");
 #endif
     c.rank_order = orders.at(order_name);
     c.placement = kinds.at(placement_name);
@@ -616,6 +621,23 @@ int main(int argc, char** argv) {
       std::printf("physics (Bullet): %d of %d checked, %d stayed, %d moved down the ranking; "
                   "%.1f ms (shapes %.1f ms, %.1f ms per candidate, %d threads)\n",
                   v.checked, v.selected, v.stayed, v.demoted, v.total_ms, v.shape_ms, v.per_check_ms, v.threads);
+    }
+#endif
+#ifdef PLACE_PLANNER_HAVE_VALIDATION
+    if (!picture_path.empty() && !r.candidates.empty()) {
+      // Seen from beside the approach, a little from above: a threading along a peg shows.
+      const Candidate& best = r.candidates.front();
+      const Eigen::Vector3d a = best.placement.approach.direction.norm() > 0 ? best.placement.approach.direction
+                                                                             : Eigen::Vector3d(0, 0, -1);
+      const Eigen::Vector3d g = c.gravity.normalized();
+      Eigen::Vector3d side = a.cross(g);
+      if (side.norm() < 1e-6) side = a.unitOrthogonal();
+      const Eigen::Vector3d view = (side.normalized() + 0.6 * a + 0.4 * g).normalized();
+      const Eigen::Vector3d com = object.properties.center_of_mass;
+      validation::renderPlacement(picture_path, area, object, best.X_WO, view, best.placement.pre_place_W * com,
+                                  best.intermediate_poses.empty() ? best.X_WO * com
+                                                                  : best.intermediate_poses.front() * com);
+      std::printf("picture: %s\n", picture_path.c_str());
     }
 #endif
     printTable(r);

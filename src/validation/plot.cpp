@@ -6,8 +6,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace place_planner {
@@ -188,6 +190,88 @@ void plotBars(const std::string& path, const std::string& title, const std::stri
   cv::rectangle(a.img, a.box, kBlack, 1);
   legend(a, series);
   save(path, a.img);
+}
+
+void renderPlacement(const std::string& path, const Mesh& area_W, const Mesh& object_O, const Eigen::Isometry3d& X_WO,
+                     const Eigen::Vector3d& view, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                     double radius, int width, int height) {
+  const Eigen::Vector3d d = view.normalized();
+  // Image axes: right = up x d... with up the world's z where it is not along the view.
+  const Eigen::Vector3d world_up = std::abs(d.z()) < 0.95 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d right = d.cross(world_up).normalized(), up = right.cross(d);
+  const Eigen::Vector3d centre = X_WO * object_O.properties.center_of_mass;
+  struct Tri {
+    std::array<Eigen::Vector3d, 3> p;
+    cv::Scalar colour;
+  };
+  std::vector<Tri> tris;
+  auto add = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const cv::Scalar& base) {
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() < 1e-15) return;
+    n.normalize();
+    const Eigen::Vector3d light = (-d + 0.6 * up).normalized();
+    const double shade = 0.35 + 0.65 * std::abs(n.dot(light));
+    tris.push_back({{a, b, c}, base * shade});
+  };
+  for (const auto& t : area_W.triangles) {
+    const Eigen::Vector3d &a = area_W.vertices[t[0]], &b = area_W.vertices[t[1]], &c = area_W.vertices[t[2]];
+    if ((a - centre).norm() > radius && (b - centre).norm() > radius && (c - centre).norm() > radius) continue;
+    add(a, b, c, cv::Scalar(200, 200, 200));
+  }
+  for (const auto& t : object_O.triangles)
+    add(X_WO * object_O.vertices[t[0]], X_WO * object_O.vertices[t[1]], X_WO * object_O.vertices[t[2]],
+        cv::Scalar(40, 140, 245));  // BGR: orange
+  // Fit: the object and its approach with a margin, the area around them.
+  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+  auto fit = [&](const Eigen::Vector3d& q) {
+    const double x = (q - centre).dot(right), y = (q - centre).dot(up);
+    x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  };
+  for (const auto& v : object_O.vertices) fit(X_WO * v);
+  fit(from);
+  fit(to);
+  const double margin = 0.25 * std::max(x1 - x0, y1 - y0) + 0.02;
+  x0 -= margin, x1 += margin, y0 -= margin, y1 += margin;
+  const double scale = std::min(width / (x1 - x0), height / (y1 - y0));
+  auto pixel = [&](const Eigen::Vector3d& q) {
+    const double x = (q - centre).dot(right), y = (q - centre).dot(up);
+    return cv::Point(static_cast<int>(std::lround(0.5 * width + (x - 0.5 * (x0 + x1)) * scale)),
+                     static_cast<int>(std::lround(0.5 * height - (y - 0.5 * (y0 + y1)) * scale)));
+  };
+  // Depth buffer: each pixel keeps the nearest triangle along the view.
+  cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
+  std::vector<double> depth(static_cast<size_t>(width) * height, std::numeric_limits<double>::infinity());
+  for (const Tri& t : tris) {
+    Eigen::Vector3d q[3];  // pixel x, y and depth
+    for (int k = 0; k < 3; ++k) {
+      const cv::Point2d p((t.p[k] - centre).dot(right), (t.p[k] - centre).dot(up));
+      q[k] = Eigen::Vector3d(0.5 * width + (p.x - 0.5 * (x0 + x1)) * scale, 0.5 * height - (p.y - 0.5 * (y0 + y1)) * scale,
+                             t.p[k].dot(d));
+    }
+    const double area = (q[1].x() - q[0].x()) * (q[2].y() - q[0].y()) - (q[1].y() - q[0].y()) * (q[2].x() - q[0].x());
+    if (std::abs(area) < 1e-12) continue;
+    const int xa = std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}))));
+    const int xb = std::min(width - 1, static_cast<int>(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}))));
+    const int ya = std::max(0, static_cast<int>(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}))));
+    const int yb = std::min(height - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}))));
+    for (int y = ya; y <= yb; ++y)
+      for (int x = xa; x <= xb; ++x) {
+        const double px = x + 0.5, py = y + 0.5;
+        const double w0 = ((q[1].x() - px) * (q[2].y() - py) - (q[1].y() - py) * (q[2].x() - px)) / area;
+        const double w1 = ((q[2].x() - px) * (q[0].y() - py) - (q[2].y() - py) * (q[0].x() - px)) / area;
+        const double w2 = 1 - w0 - w1;
+        if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+        const double z = w0 * q[0].z() + w1 * q[1].z() + w2 * q[2].z();
+        double& best = depth[static_cast<size_t>(y) * width + x];
+        if (z >= best) continue;
+        best = z;
+        img.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(t.colour[0]), cv::saturate_cast<uchar>(t.colour[1]),
+                                            cv::saturate_cast<uchar>(t.colour[2]));
+      }
+  }
+  if ((to - from).norm() > 1e-6)
+    cv::arrowedLine(img, pixel(from), pixel(to), cv::Scalar(200, 90, 20), 3, cv::LINE_AA, 0, 0.08);
+  save(path, img);
 }
 
 }  // namespace validation

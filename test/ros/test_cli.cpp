@@ -455,6 +455,27 @@ TEST(PlacePlannerCli, JsonDashGoesToStdoutAndTheReportToStderr) {
   EXPECT_TRUE(contains(r.err, "floor points")) << r.err;
 }
 
+// --placement: a ring on the wall of pegs hangs, and the JSON and the table say so; standing
+// only, it does not; an unknown kind is bad input naming the option.
+TEST(PlacePlannerCli, PlacementHangingIsChosenAndReported) {
+  const CliRun r = cli({"--object", "builtin:ring", "--area", "builtin:peg_wall", "--placement", "hanging", "--threads",
+                        "2", "--json", "-"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  ASSERT_TRUE(json::accept(r.out)) << r.out.substr(0, 200);
+  const json j = json::parse(r.out);
+  ASSERT_GT(j.at("candidates").size(), 0u);
+  EXPECT_EQ(j.at("candidates")[0].at("kind"), "hanging");
+  EXPECT_EQ(j.at("candidates")[0].at("start"), "loop_on_peg");
+  EXPECT_TRUE(contains(r.err, "hanging: 6 pegs on the area, 1 loops of the object")) << r.err;
+  const CliRun standing = cli({"--object", "builtin:ring", "--area", "builtin:peg_wall", "--placement", "standing",
+                               "--threads", "2", "--json", "-"});
+  ASSERT_TRUE(json::accept(standing.out)) << standing.out.substr(0, 200);
+  for (const json& c : json::parse(standing.out).at("candidates")) EXPECT_EQ(c.at("kind"), "standing");
+  const CliRun bad = cli(cubeOnTable({"--placement", "dangling"}));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(contains(bad.out + bad.err, "--placement")) << bad.out << bad.err;
+}
+
 // The CPU is the normal case for `auto`: named once in the times block, no warning; -v says why.
 TEST(PlacePlannerCli, CpuBackendIsNamedOnceAndNotAWarning) {
   std::string why;

@@ -38,9 +38,6 @@ class ContactForces {
   // True when non-negative forces in the cones balance f_ext at the centre of mass within
   // max_load |f_ext|; `forces`: the cone-edge weights found (edges * contacts).
   bool balances(const Eigen::Vector3d& f_ext, Eigen::VectorXd* forces = nullptr) const;
-  // The forces alone (no torque rows): friction holds f_ext, whatever turn it would cause (a
-  // hanging object swings until its torque is zero; see evaluateStability).
-  bool balancesForce(const Eigen::Vector3d& f_ext) const;
   // The largest push alpha in [0, cap] (in weights) along the horizontal unit direction d that
   // the contacts resist together with gravity: balances(-z + alpha d), by bisection to cap / 2^7.
   // 0 when gravity alone is not balanced.

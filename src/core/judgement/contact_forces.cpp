@@ -131,18 +131,6 @@ bool ContactForces::balances(const Eigen::Vector3d& f_ext, Eigen::VectorXd* forc
   return residual < 1e-4 * f_ext.norm() && load <= max_load_ * f_ext.norm();
 }
 
-bool ContactForces::balancesForce(const Eigen::Vector3d& f_ext) const {
-  if (A_.cols() == 0) return false;
-  Eigen::Matrix<double, 7, Eigen::Dynamic> A = A_;
-  A.middleRows<3>(3).setZero();
-  Eigen::Matrix<double, 7, 1> b = Eigen::Matrix<double, 7, 1>::Zero();
-  b.head<3>() = -f_ext;
-  Eigen::VectorXd x;
-  nnlsRows<7>(A, b, &x);
-  const double residual = (A.topRows(3) * x - b.head<3>()).norm();
-  return residual < 1e-4 * f_ext.norm() && A.row(6).dot(x) / kLoadWeight <= max_load_ * f_ext.norm();
-}
-
 Eigen::Vector3d ContactForces::contactForce(const Eigen::VectorXd& forces, size_t i) const {
   Eigen::Vector3d f = Eigen::Vector3d::Zero();
   for (int k = 0; k < edges_; ++k) {

@@ -120,15 +120,19 @@ Eigen::Vector3d farthest(const std::vector<ContactPoint>& c, const Eigen::Vector
   return best;
 }
 
-// The contact forces (contact_forces.h) on the contacts merged (reduceContacts) in cells of an
-// eighth of their extent (at least the contact tolerance): a few dozen at most, so the NNLS stays small whatever
-// the sphere model's density.
-ContactForces forceModel(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
-                         const StabilityParams& prm) {
+// The contacts merged (reduceContacts) in cells of an eighth of their extent (at least the
+// contact tolerance): a few dozen at most, so the NNLS stays small whatever the sphere model's
+// density.
+std::vector<ContactPoint> forceContacts(const std::vector<ContactPoint>& contacts, const StabilityParams& prm) {
   double extent = 0;
   for (const ContactPoint& p : contacts) extent = std::max(extent, (p.p_W - contacts.front().p_W).norm());
-  return ContactForces(reduceContacts(contacts, std::max(prm.tol, extent / 8)), com,
-                       ForceModelParams{prm.friction, 8, prm.max_load});
+  return reduceContacts(contacts, std::max(prm.tol, extent / 8));
+}
+
+// The contact forces (contact_forces.h) on the merged contacts.
+ContactForces forceModel(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
+                         const StabilityParams& prm) {
+  return ContactForces(forceContacts(contacts, prm), com, ForceModelParams{prm.friction, 8, prm.max_load});
 }
 
 // Where only friction fails (slipDirection: wide cones would hold it), the horizontal direction
@@ -136,10 +140,7 @@ ContactForces forceModel(const std::vector<ContactPoint>& contacts, const Eigen:
 // behind it), where the paper's tip direction would turn it over.
 Eigen::Vector3d slipOf(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
                        const StabilityParams& prm) {
-  double extent = 0;
-  for (const ContactPoint& p : contacts) extent = std::max(extent, (p.p_W - contacts.front().p_W).norm());
-  return slipDirection(reduceContacts(contacts, std::max(prm.tol, extent / 8)), com,
-                       ForceModelParams{prm.friction, 8, prm.max_load}, 1.0, true);
+  return slipDirection(forceContacts(contacts, prm), com, ForceModelParams{prm.friction, 8, prm.max_load}, 1.0, true);
 }
 
 // Hanging: the contact forces, inside their friction cones, balance gravity (the centre of mass
@@ -190,8 +191,8 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
   r.stable = holds;
   r.friction_ok = holds;
   r.com_inside = r.balanced;
-  // Q: how far below its support the centre of mass hangs, against the support's spread (a
-  // deep pendulum swings back from a push; one just under a wide support barely).
+  // Q: 1 less the centre of mass's horizontal offset from the support's centre over the
+  // support's reach (at least 0.3): straight below its support, a pendulum's Q is 1.
   double reach = 1e-9;
   for (const auto& p : contacts) reach = std::max(reach, (p.p_W - c).norm());
   const Eigen::Vector3d off = com - c;

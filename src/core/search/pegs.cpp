@@ -79,14 +79,19 @@ std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSig
     if (ray(am, top - (t + 2 * kEps) * up, -up, p.min_free_below) < p.min_free_below) continue;
     const Eigen::Vector3d c = top - (kEps + 0.5 * t) * up;
     // The axis: the horizontal direction the part is longest in, then its slope in that plane.
+    // Every 30 degrees first: one of those is within 15 degrees of across a peg, where its span
+    // is under 1.04 times its width; a slab (a book overhanging the one below) is wide every way.
     Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
-    double longest = 0;
-    for (int k = 0; k < 12; ++k) {
+    double longest = 0, narrowest = kInf;
+    for (const int k : {0, 2, 4, 6, 8, 10, 1, 3, 5, 7, 9, 11}) {
+      if (k == 1 && narrowest > 1.04 * p.max_thickness) break;
       const double a = M_PI * k / 12;
       const Eigen::Vector3d d(std::cos(a), std::sin(a), 0);
       const double len = span(am, c, d).total();
+      narrowest = std::min(narrowest, len);
       if (len > longest) longest = len, axis = d;
     }
+    if (narrowest > 1.04 * p.max_thickness) continue;
     const Eigen::Vector3d side = up.cross(axis).normalized();
     const Span across = span(am, c, side);
     const double width = across.total();

@@ -20,13 +20,14 @@ TiltAxis tiltAxis(const std::vector<ContactPoint>& contacts, const Eigen::Vector
     spread = std::max(spread, (p.p_W - c).norm());
   }
   a.s_A = c;
+  // The centre of mass's offset from the contacts' middle, across gravity.
+  const Eigen::Vector3d off_h = (com - c) - (com - c).dot(d_g) * d_g;
   constexpr double kLineAspect = 0.1;  // half-width / length of a line contact
   // Parallel test: sin of the angle below ~0.6 degrees.
   constexpr double kParallel = 1e-2;
   if (spread <= tol) {
     a.layout = ContactLayout::kSingle;
     // Hanging from one point (the centre of mass below it): it swings across its offset.
-    const Eigen::Vector3d off_h = (com - c) - (com - c).dot(d_g) * d_g;
     if ((com - c).dot(d_g) > tol && off_h.norm() > 1e-6) {
       a.d_A = off_h.cross(d_g).normalized();
       return a;
@@ -59,7 +60,6 @@ TiltAxis tiltAxis(const std::vector<ContactPoint>& contacts, const Eigen::Vector
     // The centre of mass beyond an end of the line, along it (a pen's foot in a cup's corner,
     // the cluster running towards its lean): it tips over that end, about the horizontal axis
     // across its offset, as from one point.
-    const Eigen::Vector3d off_h = (com - c) - (com - c).dot(d_g) * d_g;
     const Eigen::Vector3d dir_h = dir - dir.dot(d_g) * d_g;
     const double along = off_h.dot(dir_h.normalized());
     if (dir_h.norm() > 0.5 && off_h.norm() > tol && std::abs(along) > std::cos(M_PI / 4) * off_h.norm() &&

@@ -40,6 +40,8 @@ void expectHangsOnAPeg(const Mesh& object, const PlanResult& r) {
   EXPECT_EQ(best.start, StartKind::kLoopOnPeg);
   EXPECT_GT(best.placement.approach.direction.y(), 0.95) << "not threaded along the peg";
   EXPECT_FALSE(best.placement.straight);
+  // The path: threaded, lowered onto the peg, and where it swings to (not every step of the swing).
+  EXPECT_LE(best.intermediate_poses.size(), 8u);
   // The pre-place pose is beyond the peg's tip (the pegs end at y = -0.01), on the peg's line.
   EXPECT_LT(best.placement.pre_place_W.translation().y(), best.X_WO.translation().y() - 0.05);
   // Every contact is above the centre of mass, which hangs within 5 mm of straight below them.

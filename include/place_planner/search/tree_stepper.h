@@ -52,6 +52,7 @@ struct TreeNode {
   double swing_step = 0;
   int swings = 0;
   bool swung = false;
+  int swing_pose = -1;  // index in `path` of the swing's last pose (-1: none)
   // The peg it was threaded on, if any. The swing turns the loop round the peg and slides it
   // across, never along it: along it friction decides.
   PegLine peg;

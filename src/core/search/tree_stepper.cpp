@@ -353,15 +353,16 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
 }
 
 // ---------------------------------------------------------------- the swing (beyond the paper)
-// A hanging object comes to rest where its centre of mass is lowest: a pendulum's rest, found
-// by descent. Each step tries the object turned both ways about two horizontal axes through the
-// middle of its contacts (a swing, and the roll of a loop on its peg) and, on a known peg, moved
-// both ways across the peg (a loop sliding over it), each lowered back onto the support (V-A's
-// translation); it takes the move that lowers the centre of mass most, or halves the step when
-// none does, from kSwingStart down to kSwingEnd. Along the peg friction decides (the stability
-// test's tilted gravity), so it is not a move. The exact rotation to
-// the next contact (V-C.2) does not serve here: a loop's own contacts, within a collision
-// distance of the peg all round it, stop a turn after a fraction of a degree.
+// A hanging object on its peg comes to rest where its centre of mass is lowest: a pendulum's
+// rest, found by descent. Each step tries the object turned both ways about the two horizontal
+// axes (along and across the peg) through the middle of its contacts (a swing, a pitch), about
+// the peg's axis (the loop sliding round the peg) and moved both ways across the peg (a loop
+// sliding over it), each lowered back onto the support (V-A's translation); it takes the move
+// that lowers the centre of mass most, or halves the step when none does, from kSwingStart down
+// to kSwingEnd. Along the peg friction decides (the stability test), so that is not a move. The
+// exact rotation to the next contact (V-C.2) does not serve here: a loop's own contacts, within a
+// collision distance of the peg all round it, stop a turn after a fraction of a degree. The path
+// keeps the swing's last pose only: the robot lets go, the object swings by itself.
 void TreeStepper::swingStep() {
   const auto t0 = Clock::now();
   constexpr double kSwingStart = 4.0 * M_PI / 180.0, kSwingEnd = 0.25 * M_PI / 180.0;
@@ -413,7 +414,10 @@ void TreeStepper::swingStep() {
     // degrees) a centre of mass 1 mm off under a 6 cm pendulum drops 4 micrometres.
     if (best != 0 && h[best] < h[0] - kSwingDrop) {
       n.X_GO = translated(q[i * kMoves + best].X_GO, v3(0, 0, -d[i * kMoves + best]));
-      n.path.push_back(n.X_GO);
+      // The path's last pose is replaced while the swing goes on (nothing else moved it since).
+      if (n.swing_pose == static_cast<int>(n.path.size()) - 1) n.path.back() = n.X_GO;
+      else n.path.push_back(n.X_GO);
+      n.swing_pose = static_cast<int>(n.path.size()) - 1;
       ++n.turns;
     } else {
       n.swing_step *= 0.5;

@@ -132,6 +132,7 @@ RobustnessParams robustnessParams(const PlannerConfig& config, bool scanned) {
   RobustnessParams rp;
   // Shape noise of a scan (config.h scan_noise) through the centre-of-mass trials.
   rp.min_com_offset = scanned ? config.scan_noise : 0.0;
+  if (scanned && config.scan_noise > 0) rp.end_roll_move = 0;  // its rolls are its shape's noise
   rp.shift = config.robust_shift;
   rp.tilt = config.robust_tilt_deg * M_PI / 180.0;
   rp.com_offset = config.robust_com_offset;

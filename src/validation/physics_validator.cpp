@@ -18,6 +18,7 @@
 
 #include "place_planner/infra/parallel_for.h"
 #include "place_planner/infra/stable_sort.h"
+#include "place_planner/search/loops.h"
 
 namespace place_planner {
 namespace validation {
@@ -358,6 +359,13 @@ struct PhysicsValidator::Impl {
   double linearSpeed(const btRigidBody& b) const { return b.getLinearVelocity().length() / cfg.world_scale; }
 };
 
+bool stillHanging(const PoseCheck& check, const Eigen::Isometry3d& X_WO_goal, const Eigen::Vector3d& com_O,
+                  const ValidatorConfig& config) {
+  const Eigen::Vector3d up = -config.gravity.normalized();
+  const double dropped = (X_WO_goal * com_O - check.X_WO_final * com_O).dot(up);
+  return !check.interrupted && check.moved_m < config.max_translation && dropped < 0.005;
+}
+
 PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
                                    const ValidatorConfig& config)
     : impl_(std::make_unique<Impl>()) {
@@ -375,10 +383,14 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
   // A (nearly) convex closed object is one hull: exact and much cheaper than pieces.
   std::vector<std::vector<Eigen::Vector3d>> pieces;
   d.convexity = meshConvexity(object_O);
-  if (d.convexity >= config.convex_volume_ratio)
+  if (d.convexity >= config.convex_volume_ratio) {
     pieces.push_back(object_O.vertices);
-  else
-    pieces = makeConvexPieces(object_O, config);
+  } else {
+    ValidatorConfig pc = config;
+    if (config.loop_sized_pieces)
+      for (const Loop& l : findLoops(object_O)) pc.piece_max_size = std::min(pc.piece_max_size, l.radius);
+    pieces = makeConvexPieces(object_O, pc);
+  }
   for (const auto& pts : pieces) {
     // Shrink every face of the slab by both margins (object's and area's): Bullet keeps the
     // margin-inflated shapes apart, so the true surfaces then touch where the geometry says

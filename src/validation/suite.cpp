@@ -166,6 +166,39 @@ std::vector<ScenePair> scanPairs(const std::string& data_dir, const std::vector<
   return pairs;
 }
 
+std::vector<ScenePair> hangingPairs(const std::string& data_dir) {
+  struct Obj {
+    std::string name, object, plan, mode;
+  };
+  std::vector<Obj> objects;
+  const bool data = !data_dir.empty() && std::ifstream(data_dir + "/objects/mug_ycb025_1k.ply").good();
+  if (data) {
+    objects.push_back({"mug_ycb025_1k", data_dir + "/objects/mug_ycb025_1k.ply", "", "mesh"});
+    objects.push_back({"mug_lowpoly", data_dir + "/objects/mug_lowpoly.ply", "", "mesh"});
+    for (const char* mode : {"allaround", "upper", "inhand"}) {
+      const std::string scan = data_dir + "/scans/objects/mug_ycb025_" + mode + "_scan.ply";
+      if (!std::ifstream(scan).good()) continue;
+      const std::string m = mode;
+      objects.push_back({"mug_ycb025_" + m + "_scan", data_dir + "/objects/mug_ycb025.ply", scan,
+                         m == "allaround" ? "all_around" : m == "inhand" ? "in_hand" : m});
+    }
+  }
+  objects.push_back({"ring", "builtin:ring", "", "mesh"});
+  objects.push_back({"loop_mug", "builtin:loop_mug", "", "mesh"});
+  std::vector<ScenePair> pairs;
+  for (const char* area : {"peg_wall", "peg_wall_rising", "mug_tree"})
+    for (const Obj& o : objects) {
+      ScenePair p;
+      p.name = o.name + "@" + area;
+      p.object = o.object;
+      p.area = std::string("builtin:") + area;
+      p.object_plan = o.plan;
+      p.mode = o.mode;
+      pairs.push_back(p);
+    }
+  return pairs;
+}
+
 SceneResult runScene(const ScenePair& pair, const SuiteConfig& config) {
   try {
     if (!pair.object_plan.empty() || !pair.area_plan.empty())
@@ -226,6 +259,7 @@ SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh&
       cc.quality = c.quality;
       cc.X_WO = c.X_WO;
       cc.check = validator.check(c.X_WO);
+      if (c.hanging) cc.check.confirmed = stillHanging(cc.check, c.X_WO, object_full.properties.center_of_mass, vc);
       ++r.validated;
       r.confirmed += cc.check.confirmed ? 1 : 0;
       r.checks.push_back(cc);

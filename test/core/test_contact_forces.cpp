@@ -103,6 +103,33 @@ TEST(ContactForces, RingHangsOnAPegWithItsCentreOfMassBelow) {
   }
 }
 
+// Hung on a peg (along x) with a wall behind (at +y, facing -y) that it touches below the peg
+// (a mug at the root of a coat peg): contacts below the centre of mass that only push sideways
+// keep it hanging. Its centre of mass 5 mm off straight below the peg, away from the wall, turns
+// it into the wall, which holds it (the peg's friction takes the wall's push); without the wall,
+// or with its centre of mass on the wall's side (a wall cannot pull), it swings.
+TEST(ContactForces, HangingObjectLeansOnAWallBelowItsPeg) {
+  StabilityParams sp;  // mu 0.2
+  const std::vector<ContactPoint> peg{{{-0.003, 0, 0}, {0, 0, 1}}, {{0.003, 0, 0}, {0, 0, 1}}};
+  std::vector<ContactPoint> with_wall = peg;
+  with_wall.push_back({{0, 0.03, -0.05}, {0, -1, 0}});
+  const Stability leaning = evaluateStability(with_wall, Eigen::Vector3d(0, -0.005, -0.04), sp);
+  EXPECT_TRUE(leaning.hanging);
+  EXPECT_TRUE(leaning.stable) << "held by its peg and the wall";
+  const Stability free = evaluateStability(peg, Eigen::Vector3d(0, -0.005, -0.04), sp);
+  EXPECT_TRUE(free.hanging);
+  EXPECT_FALSE(free.stable) << "5 mm off straight below its peg, with no wall";
+  const Stability pulled = evaluateStability(with_wall, Eigen::Vector3d(0, 0.005, -0.04), sp);
+  EXPECT_FALSE(pulled.stable) << "the wall would have to pull";
+  // A floor contact below the centre of mass (its normal up) is no wall: not hanging.
+  std::vector<ContactPoint> floor = peg;
+  floor.push_back({{0, 0, -0.08}, {0, 0, 1}});
+  EXPECT_FALSE(evaluateStability(floor, Eigen::Vector3d(0, -0.005, -0.04), sp).hanging);
+  // Nor is an object that only touches a wall, above and below its centre of mass.
+  const std::vector<ContactPoint> wall{{{0, 0.03, 0.02}, {0, -1, 0}}, {{0, 0.03, -0.02}, {0, -1, 0}}};
+  EXPECT_FALSE(evaluateStability(wall, Eigen::Vector3d(0, 0, 0), sp).hanging);
+}
+
 // A 4 cm box whose lower edges touch two walls at `wall_deg` from the horizontal (a V-groove).
 std::vector<ContactPoint> vGroove(double wall_deg, bool both_walls) {
   const double a = wall_deg * M_PI / 180.0;

@@ -50,7 +50,7 @@ Mesh pen();           // thin cylinder 0.14 m long
 Mesh loopMug();       // the mug with a handle it can hang by: an opening 5.8 x 2.4 cm
 
 // Names accepted by byName(): table, dish_rack, open_box, binder_stack, shelf, peg_wall,
-// mug_tree, mug, loop_mug, ring (torus 6 cm across, 12 mm thick), plate, pen, cube.
+// peg_wall_rising (its pegs rising 10 degrees), mug_tree, mug, loop_mug, ring (torus 6 cm across, 12 mm thick), plate, pen, cube.
 Mesh byName(const std::string& name);
 std::vector<std::string> areaNames();
 std::vector<std::string> objectNames();

@@ -27,7 +27,9 @@ struct RobustnessParams {
   // tray and cup scenes, 0.971 at 2.5 deg overall; doc/validation.md).
   double end_angle = 2.5 * M_PI / 180;
   // With the centre of mass off, released at the pose: it also holds when it only rolled about
-  // its long axis and its centre of mass moved less than this (m).
+  // its long axis and its centre of mass moved less than this (m). 0 = off: for a scanned
+  // object, whose centre-of-mass trials also stand for its shape's noise (min_com_offset), a
+  // roll is where the unseen true shape may rest instead, not a rest beside the pose (planner).
   double end_roll_move = 0.003;
   // A tilted trial caught where it landed (stable, turned at most caught_angle from the pose)
   // also holds when that end pose holds its own shift and centre-of-mass trials.

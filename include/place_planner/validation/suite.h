@@ -36,6 +36,12 @@ std::vector<ScenePair> defaultPairs(const std::string& data_dir);
 // of `areas` (names of DATA/areas), planned on the scans and validated on the true meshes.
 std::vector<ScenePair> scanPairs(const std::string& data_dir, const std::vector<std::string>& areas);
 
+// The hanging suite: objects with a loop (the YCB mug, its three scans, a low-poly mug, a ring,
+// a mug with a flat-bar handle) on areas with pegs and nothing else to stand on (built-in
+// peg_wall, peg_wall_rising, mug_tree). A scan is planned on and validated on the true mug
+// (DATA/objects/mug_ycb025.ply). mode: "mesh" or the scan's mode. Built-ins only without data.
+std::vector<ScenePair> hangingPairs(const std::string& data_dir);
+
 struct SuiteConfig {
   PlannerConfig planner;        // threads is set to 1 by default (Bullet is single-threaded)
   ValidatorConfig validator;    // friction is overwritten by planner.friction

@@ -248,12 +248,13 @@ Mesh byName(const std::string& n) {
   if (n == "plate") return plate();
   if (n == "pen") return pen();
   if (n == "peg_wall") return pegWall();
+  if (n == "peg_wall_rising") return pegWall(10.0);  // pegs rising 10 degrees towards their tips
   if (n == "mug_tree") return mugTree();
   if (n == "loop_mug") return loopMug();
   if (n == "ring") return torus(0.03, 0.006);
   if (n == "cube") return box(0.1, 0.1, 0.1, {0, 0, 0.05});
   throw std::invalid_argument("unknown built-in scene '" + n +
-                              "' (table, dish_rack, open_box, binder_stack, shelf, peg_wall, mug_tree, mug, loop_mug, ring, plate, pen, cube)");
+                              "' (table, dish_rack, open_box, binder_stack, shelf, peg_wall, peg_wall_rising, mug_tree, mug, loop_mug, ring, plate, pen, cube)");
 }
 
 std::vector<std::string> areaNames() { return {"table", "dish_rack", "open_box", "binder_stack"}; }

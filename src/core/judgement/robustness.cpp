@@ -12,8 +12,6 @@ namespace place_planner {
 namespace {
 
 constexpr int kTrials = 12;
-// A hanging pose's trials are not pruned by their turn (see the hold test).
-constexpr double kPendulumTurn = 1e9;
 const bool kTraceTrials = std::getenv("PP_ROBUST_TRACE") != nullptr;
 
 struct Trial {
@@ -94,15 +92,16 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   const V3 k1_O = toV3(Eigen::Vector3d(om.principal_axes.col(0)));
   // Hanging poses (supports finite): pendulums, whose trials swing (see below).
   auto pendulum = [&](size_t i) { return i < supports.size() && supports[i].allFinite(); };
-  auto near = [&](const Rigid& X, int trial, double scale, double angle_scale = 0) {
+  // any_turn: only the centre of mass counts (a hanging pose's trials, see the hold test).
+  auto near = [&](const Rigid& X, int trial, double scale, bool any_turn = false) {
     const size_t i = trial / kTrials;
     const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(X, om.com));
     const double moved = (c1 - c0).norm();
     if (moved > scale * p.end_distance) return false;
-    if (rotationAngle(X, X_GO[i]) <= (angle_scale > 0 ? angle_scale : scale) * p.end_angle) return true;
+    if (any_turn || rotationAngle(X, X_GO[i]) <= scale * p.end_angle) return true;
     // Released at the pose with the centre of mass off, an object lying on its side that only
-    // rolls about its long axis k1 to its heavier side stays where it was put (a marker's rest
-    // roll moves tens of degrees for a millimetre of centre of mass): these trials also hold
+    // rolls about its long axis k1 to its heavier side stays where it was put (an elliptic
+    // rod's rest roll moves ten degrees for 1.6 mm of centre of mass): these trials also hold
     // when k1 kept its direction and the centre of mass moved less than end_roll_move.
     if (trial % kTrials < 8 || moved > scale * p.end_roll_move) return false;
     const double c = std::clamp(dot(rotate(X, k1_O), rotate(X_GO[i], k1_O)), -1.0, 1.0);
@@ -182,7 +181,7 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
         const size_t i = n.root / kTrials;
         // A hanging pose's trial swings (its rest turns with its centre of mass): pruned at twice
         // the distance, its turn unbounded (a ring spins).
-        if (failures[i] <= allowed && near(n.X_GO, n.root, 2.0, pendulum(i) ? kPendulumTurn : 0)) return false;
+        if (failures[i] <= allowed && near(n.X_GO, n.root, 2.0, pendulum(i))) return false;
         if (failures[i] <= allowed) {
           if (kTraceTrials)
             std::fprintf(stderr, "trial pose %zu k %d pruned turned %.2f\n", i, n.root % kTrials,

@@ -12,6 +12,9 @@
 namespace place_planner {
 namespace {
 
+// A contact whose normal is within asin(0.3) = 17 degrees of horizontal pushes sideways only.
+constexpr double kSideContact = 0.3;
+
 const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();  // -d_g in G
 
 
@@ -143,6 +146,15 @@ Eigen::Vector3d slipOf(const std::vector<ContactPoint>& contacts, const Eigen::V
   return slipDirection(forceContacts(contacts, prm), com, ForceModelParams{prm.friction, 8, prm.max_load}, 1.0, true);
 }
 
+// A pose that slips (slip non-zero) slides that way, before any turn.
+bool slides(Stability& r, const Eigen::Vector3d& slip) {
+  if (slip.norm() == 0) return false;
+  r.failure = Failure::kSlide;
+  r.slips = true;
+  r.d_f = slip;
+  return true;
+}
+
 // Hanging: the contact forces, inside their friction cones, balance gravity (the centre of mass
 // straight below the support). A ring on a peg sloping down past atan mu slides off.
 Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
@@ -206,11 +218,7 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
   const Eigen::Vector3d slip = holds || r.balanced ? Eigen::Vector3d::Zero() : slipOf(support, com, prm);
   if (holds) {
     r.failure = Failure::kNone;
-  } else if (slip.norm() > 0) {
-    r.failure = Failure::kSlide;
-    r.slips = true;
-    r.d_f = slip;
-  } else {
+  } else if (!slides(r, slip)) {
     // It swings: towards its centre of mass's side, about the support.
     r.failure = Failure::kTip;
     const Eigen::Vector3d h(off.x(), off.y(), 0);
@@ -248,13 +256,17 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   // whose heuristic needs contacts beneath the centre of mass: its stated limit). Every contact
   // above the centre of mass, pushing up on the whole (an object pressed under a table is not
   // hanging: its contacts push down).
-  double lowest = std::numeric_limits<double>::infinity();
+  // Below the centre of mass only side contacts (a wall the hanging object leans on, normals
+  // within kSideContact of horizontal), nothing that holds it up from below.
+  // And a support above it that pushes up (a wall alone holds nothing up).
+  bool hangs = true, held_above = false;
   Eigen::Vector3d up_push = Eigen::Vector3d::Zero();
   for (const auto& p : contacts) {
-    lowest = std::min(lowest, p.p_W.z());
+    if (p.p_W.z() <= com.z() + prm.tol) hangs = hangs && std::abs(p.n_W.dot(kUp)) < kSideContact;
+    else held_above = held_above || p.n_W.dot(kUp) >= kSideContact;
     up_push += p.n_W;
   }
-  if (lowest > com.z() + prm.tol && up_push.dot(kUp) > 0) return hangingStability(contacts, com, prm);
+  if (hangs && held_above && up_push.dot(kUp) > 0) return hangingStability(contacts, com, prm);
   // ---------------------------------------------------------------- planar case
   std::vector<Eigen::Vector3d> pts;
   for (const auto& p : contacts) pts.push_back(p.p_W);
@@ -302,10 +314,8 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     if (!faces_on_plane && !r.balanced) slip = slipOf(contacts, com, prm);
     if (r.stable) {
       r.failure = Failure::kNone;
-    } else if (slip.norm() > 0) {
-      r.failure = Failure::kSlide;
-      r.slips = true;
-      r.d_f = slip;
+    } else if (slides(r, slip)) {
+      // slides along slip
     } else if (!r.friction_ok) {
       r.failure = Failure::kSlide;
       const Eigen::Vector3d down = -kUp - (-kUp).dot(n) * n;  // d_g projected onto P
@@ -356,11 +366,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   if (stable) {
     r.failure = Failure::kNone;
     r.quality = std::max(r.quality, 0.3);  // Q is a ranking here; equilibrium decided stability
-  } else if (slip.norm() > 0) {
-    r.failure = Failure::kSlide;
-    r.slips = true;
-    r.d_f = slip;
-  } else {
+  } else if (!slides(r, slip)) {
     r.failure = Failure::kTip;
     r.d_f = ref.valid ? tipDirection(ref) : Eigen::Vector3d::UnitX();
     if (ref.valid) tipEdge(ref, &r.tip_edge_point, &r.tip_edge_dir);

@@ -520,7 +520,7 @@ class TreeSearch {
   std::vector<Robustness> robustness(const std::vector<size_t>& idx) {
     const auto tr = Clock::now();
     std::vector<Rigid> X;
-    std::vector<Eigen::Vector3d> supports;  // hanging leaves: the middle of their contacts
+    std::vector<Eigen::Vector3d> supports;  // hanging leaves: the middle of their contacts above the centre of mass
     std::vector<PegLine> pegs;
     for (size_t i : idx) {
       const TreeLeaf& l = leaves_[i];
@@ -528,9 +528,13 @@ class TreeSearch {
       pegs.push_back(l.peg);
       Eigen::Vector3d c = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
       if (l.hanging && !l.contacts.empty()) {
+        // The peg's contacts, not a wall's it leans on below (stability.cpp).
+        const double com_z = apply(l.X_GO, ctx_.om.com).z;
+        int n = 0;
         c.setZero();
-        for (const ContactPoint& p : l.contacts) c += p.p_W;
-        c /= static_cast<double>(l.contacts.size());
+        for (const ContactPoint& p : l.contacts)
+          if (p.p_W.z() > com_z) c += p.p_W, ++n;
+        c /= static_cast<double>(std::max(n, 1));
       }
       supports.push_back(c);
     }

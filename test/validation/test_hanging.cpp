@@ -95,6 +95,36 @@ TEST(Hanging, MugWithHolesStillHangs) {
   expectHangsOnAPeg(mug, r);
 }
 
+// A mug tree's arms rise 25 degrees, past the friction angle (atan 0.2 = 11.3): hung on an arm,
+// the mug slides down it to the post. It is threaded on until it meets the post and hangs there,
+// its body leaning on the post below the arm; Bullet keeps it hanging.
+TEST(Hanging, MugHangsAtTheRootOfAMugTreesRisingArm) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh tree = scenes::mugTree();
+  PlannerConfig c = twoThreads();
+  c.placement = PlacementKind::kHanging;
+  const PlanResult r = Planner().plan(mug, tree, c);
+  ASSERT_GT(r.stableCount(), 0) << "the mug hangs on no arm";
+  const Candidate& best = r.candidates.front();
+  ASSERT_TRUE(best.stable);
+  EXPECT_TRUE(best.hanging);
+  EXPECT_EQ(best.start, StartKind::kLoopOnPeg);
+  // Held from above by an arm: some contact above the centre of mass, within the arm's first
+  // 3 cm from the post (radius 12 mm), where it slid to.
+  const Eigen::Vector3d com = best.X_WO * mug.properties.center_of_mass;
+  int above = 0;
+  for (const ContactPoint& p : best.contacts)
+    if (p.p_W.z() > com.z() + 0.01) {
+      ++above;
+      EXPECT_LT(p.p_W.head<2>().norm(), 0.012 + 0.03) << "not at the arm's root";
+    }
+  EXPECT_GT(above, 0);
+  const PoseCheck p = PhysicsValidator(mug, tree, damped()).check(best.X_WO);
+  EXPECT_TRUE(stillHanging(p, best.X_WO, mug.properties.center_of_mass, damped()))
+      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
+}
+
 // The YCB mug hung by its handle stays on its peg in Bullet. The validator cuts a looped object
 // into pieces no wider than its loop (ValidatorConfig::loop_sized_pieces); with 5 cm pieces
 // the handle's opening is bridged and Bullet pushes the mug off the peg (5-8 cm).

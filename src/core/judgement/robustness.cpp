@@ -143,12 +143,13 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
       stepper.step(leaves);
       for (const TreeLeaf& l : leaves) {
         bool held = (l.stable || l.supported) && near(l.X_GO, l.root, 1.0);
-        // A hanging pose's trial holds when it still hangs, stable, with its centre of mass
-        // within end_distance of the pose's, whatever its turn (a pendulum's rest turns with its
-        // centre of mass: a ring with it moved off its middle spins to hang it lowest).
+        // A hanging pose's trial holds when it ends stable (hanging, or leaning further on a
+        // wall below its peg) with its centre of mass within end_distance of the pose's,
+        // whatever its turn (a pendulum's rest turns with its centre of mass: a ring with it
+        // moved off its middle spins to hang it lowest).
         // Its centre of mass is the trial's (moved off in the centre-of-mass trials).
         const size_t pose = l.root / kTrials;
-        if (!held && l.stable && l.hanging && pendulum(pose)) {
+        if (!held && l.stable && pendulum(pose)) {
           const Trial t = makeTrial(X_GO[pose], l.root % kTrials, om, extent[pose], p, supports[pose]);
           held = (toEigen(apply(l.X_GO, t.com_O)) - toEigen(apply(X_GO[pose], om.com))).norm() <= p.end_distance;
         }
@@ -167,8 +168,8 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
         if (kTraceTrials) {
           const size_t i = l.root / kTrials;
           const Eigen::Vector3d c0 = toEigen(apply(X_GO[i], om.com)), c1 = toEigen(apply(l.X_GO, om.com));
-          std::fprintf(stderr, "trial pose %zu k %d stable %d supported %d rest %d moved %.4f turned %.2f tip %.2f held %d\n",
-                       i, l.root % kTrials, l.stable, l.supported, l.at_rest, (c1 - c0).norm(),
+          std::fprintf(stderr, "trial pose %zu k %d stable %d hanging %d supported %d rest %d moved %.4f turned %.2f tip %.2f held %d\n",
+                       i, l.root % kTrials, l.stable, l.hanging, l.supported, l.at_rest, (c1 - c0).norm(),
                        rotationAngle(l.X_GO, X_GO[i]) * 180 / M_PI, l.tipping_angle * 180 / M_PI, held);
         }
         if (!held) fail(l.root);

@@ -8,6 +8,8 @@ namespace place_planner {
 namespace {
 // sin(2 degrees): a peg rising more than this is hung where the object slides down to.
 constexpr double kRisingSlope = 0.035;
+// m: short of the first contact towards the base (a release a few millimetres off still clears it).
+constexpr double kBaseGap = 0.001;
 }  // namespace
 
 std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,
@@ -70,7 +72,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
     if (t[i] >= starts[i].approach_distance + 1e-3) free.push_back(starts[i]);
   // On a peg rising towards its tip the object would slide back down it: it is threaded on
   // until its first contact towards the base (V-A's translation along the peg: the wall, a
-  // post, what hangs below meeting them first), a millimetre short of it, and hangs there.
+  // post, what hangs below meeting them first), kBaseGap short of it, and hangs there.
   std::vector<TranslationQuery> slides;
   std::vector<size_t> sliding;
   for (size_t i = 0; i < free.size(); ++i)
@@ -82,7 +84,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   backend.distance(slides, t);
   for (size_t k = 0; k < sliding.size(); ++k) {
     HangingStart& h = free[sliding[k]];
-    const double s = std::max(0.0, std::min(t[k], 0.2) - 0.001);
+    const double s = std::max(0.0, std::min(t[k], 0.2) - kBaseGap);
     h.X_GO.t = h.X_GO.t + toV3(s * h.approach);
     h.approach_distance += s;
     h.peg_point += s * h.approach;

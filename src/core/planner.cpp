@@ -422,8 +422,11 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
                          .has_value();
   for (std::string& w : floor_warnings) run.result.warnings.push_back(std::move(w));
   if (!found) return std::nullopt;
-  for (const HangingStart& h : hangingStarts(pegs, loops, m.om, *m.backend, m.rad.cd))
+  int threaded = 0;
+  for (const HangingStart& h : hangingStarts(pegs, loops, m.om, *m.backend, m.rad.cd)) {
+    ++threaded;
     if (gripperTiltOk(toIsometry(h.X_GO).linear(), run.config)) r.hanging.push_back(h);
+  }
   run.st().steps.floor_points = msSince(tp);
   run.st().pegs = static_cast<int>(pegs.size());
   run.st().loops = static_cast<int>(loops.size());
@@ -432,7 +435,10 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
     run.result.warnings.push_back(
         "placement = hanging, but nothing to hang on: " + std::to_string(pegs.size()) + " pegs on the area, " +
         std::to_string(loops.size()) + " loops of the object" +
-        (pegs.empty() || loops.empty() ? "" : ", none threaded free (too short, too thick or blocked)"));
+        (pegs.empty() || loops.empty() ? ""
+         : threaded == 0           ? ", none threaded free (too short, too thick or blocked)"
+                                   : ", " + std::to_string(threaded) +
+                                         " threaded, none with the gripper within max_gripper_tilt_deg of straight down"));
   for (const StartOrientation& o : all)
     if (gripperTiltOk(o.R_GO, run.config)) r.orientations.push_back(o);
   if (r.orientations.empty() && kind != PlacementKind::kHanging)

@@ -263,3 +263,20 @@ TEST(Gripper, PlaceLocationApproachAndRetreatAreFree) {
     }
   }
 }
+
+// A hanging start whose gripper would point more than max_gripper_tilt_deg from straight down
+// is not searched, and the warning says that this is why nothing hangs: the mug held from above
+// by its rim, hung by its handle on the wall of coat pegs, has its axis and the gripper level.
+TEST(Gripper, HangingStartsBeyondTheGrippersTiltAreSaidSo) {
+  if (!haveData()) GTEST_SKIP() << "../shared/data not found at " << kData;
+  const Mesh mug = loadMesh(kData + "/objects/mug_ycb025_1k.ply");
+  PlannerConfig c = withGripper(mug, 0.055);
+  c.placement = PlacementKind::kHanging;
+  const PlanResult r = Planner().plan(mug, scenes::pegWall(), c);
+  EXPECT_EQ(r.stats.pegs, 6);
+  EXPECT_EQ(r.stats.hanging_starts, 0);
+  EXPECT_EQ(r.stableCount(), 0);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings.back().find("threaded, none with the gripper within max_gripper_tilt_deg"), std::string::npos)
+      << r.warnings.back();
+}

@@ -233,8 +233,7 @@ int main(int argc, char** argv) {
   if (hanging) {
     // Hanging poses only; a pendulum settles with light damping (air, the joint).
     cfg.planner.placement = PlacementKind::kHanging;
-    cfg.validator.linear_damping = cfg.validator.angular_damping = 0.3;
-    cfg.validator.settle_time = 3.0;
+    cfg.validator = forHanging(cfg.validator);
     return runBestPoseSuite(hangingPairs(data), filters, out, "hanging",
                             "Planned with placement hanging (scans planned on, checked on the true mug), "
                             "checked in Bullet (damping 0.3, 3 s); best = the best stable pose still hangs "

@@ -366,6 +366,12 @@ bool stillHanging(const PoseCheck& check, const Eigen::Isometry3d& X_WO_goal, co
   return !check.interrupted && check.moved_m < config.max_translation && dropped < 0.005;
 }
 
+ValidatorConfig forHanging(ValidatorConfig c) {
+  c.linear_damping = c.angular_damping = 0.3;
+  c.settle_time = std::max(c.settle_time, 3.0);
+  return c;
+}
+
 PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
                                    const ValidatorConfig& config)
     : impl_(std::make_unique<Impl>()) {
@@ -564,6 +570,14 @@ VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerCo
   vc.gravity = 9.81 * d_g;
   const PhysicsValidator validator(object_O, area_W, vc);
   s.shape_ms = validator.shapeBuildMs();
+  // Hanging candidates: checked damped and judged by stillHanging (a pendulum turns to its rest).
+  const ValidatorConfig hc = forHanging(vc);
+  std::unique_ptr<PhysicsValidator> hanging;
+  for (size_t i : picked)
+    if (cands[i].hanging && !hanging) {
+      hanging = std::make_unique<PhysicsValidator>(object_O, area_W, hc);
+      s.shape_ms += hanging->shapeBuildMs();
+    }
 
   // Indices are handed out in rank order (parallel_for.h), so the best start first; the budget
   // is read before each start.
@@ -571,7 +585,7 @@ VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerCo
   std::vector<char> ran(picked.size(), 0);
   parallelFor(picked.size(), s.threads, [&](size_t j) {
     if (!may_start()) return;
-    checks[j] = validator.check(cands[picked[j]].X_WO, may_start);
+    checks[j] = (cands[picked[j]].hanging ? *hanging : validator).check(cands[picked[j]].X_WO, may_start);
     ran[j] = !checks[j].interrupted;
   });
 
@@ -580,7 +594,8 @@ VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerCo
     if (!ran[j]) continue;
     PhysicsCheck& p = cands[picked[j]].physics;
     p.checked = true;
-    p.stayed = checks[j].confirmed;
+    const Candidate& c = cands[picked[j]];
+    p.stayed = c.hanging ? stillHanging(checks[j], c.X_WO, object_O.properties.center_of_mass, hc) : checks[j].confirmed;
     p.moved_m = checks[j].moved_m;
     p.turned_deg = checks[j].turned_deg;
     ++s.checked;

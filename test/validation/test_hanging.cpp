@@ -17,13 +17,7 @@ namespace validation {
 namespace {
 
 // A pendulum swings for long undamped: light damping, as air and the joint give it.
-ValidatorConfig damped() {
-  ValidatorConfig v;
-  v.linear_damping = 0.3;
-  v.angular_damping = 0.3;
-  v.settle_time = 3.0;
-  return v;
-}
+ValidatorConfig damped() { return forHanging(ValidatorConfig{}); }
 
 PlannerConfig twoThreads() {
   PlannerConfig c;
@@ -76,6 +70,11 @@ TEST(Hanging, RingOnAWallOfPegsHangsAndStays) {
   const PoseCheck p = PhysicsValidator(ring, wall, damped()).check(best.X_WO);
   EXPECT_LT(p.moved_m, 0.01) << "Bullet: the ring moved " << 1000 * p.moved_m << " mm";
   EXPECT_NEAR(p.X_WO_final.translation().z(), best.X_WO.translation().z(), 0.005) << "Bullet: the ring dropped";
+  // The product's physics check (CLI --verify, the node) judges a hanging candidate the same way.
+  PlanResult verified = r;
+  const VerifyStats vs = verifyTopK(ring, wall, twoThreads(), verified, 1, 0, 2);
+  EXPECT_EQ(vs.checked, 1);
+  EXPECT_TRUE(verified.candidates.front().physics.stayed);
 }
 
 // The YCB mug on the wall of pegs: the best candidate hangs by its handle.

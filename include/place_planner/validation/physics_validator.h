@@ -109,6 +109,11 @@ struct PoseCheck {
 bool stillHanging(const PoseCheck& check, const Eigen::Isometry3d& X_WO_goal, const Eigen::Vector3d& com_O,
                   const ValidatorConfig& config);
 
+// The configuration a hanging pose is checked with: c with light damping (0.3 of the velocity
+// per second, linear and angular, as air and the peg's friction give a pendulum, which swings
+// long undamped) and 3 s to settle.
+ValidatorConfig forHanging(ValidatorConfig c);
+
 // Result of drop(): the object released at rest from X_WO_start.
 struct DropResult {
   bool at_rest = false;        // velocities stayed below the thresholds for rest_steps steps
@@ -162,7 +167,8 @@ struct VerifyStats {
 
 // Physics check in the product: simulates the best `k` stable candidates of `result`
 // (candidates are ranked best first; unstable ones are skipped and do not count against k) with
-// check() above, released 2 mm above the pose: stayed = moved < 1 cm and turned < 5 deg. The
+// check() above, released 2 mm above the pose: stayed = moved < 1 cm and turned < 5 deg (a
+// hanging candidate: checked with forHanging's damping, stayed = stillHanging). The
 // object gets the plan's friction mu, gravity is 9.81 m/s^2 along cfg.gravity; everything else
 // is ValidatorConfig's default. One validator (the shapes are built once per call), the checks
 // run in rank order on `threads` threads (0 = all hardware threads), each in its own Bullet world.

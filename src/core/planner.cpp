@@ -503,7 +503,8 @@ class TreeSearch {
         const TreeLeaf& l = leaves_[i];
         const Eigen::Isometry3d X_OG = toIsometry(l.X_GO).inverse();
         for (const ContactPoint& c : l.contacts) {
-          if (run_.run_completion() && onCompletedSurface(run_.completion, X_OG * c.p_W, margin))
+          if (run_.run_completion() && (onCompletedSurface(run_.completion, X_OG * c.p_W, margin) ||
+                                        onOpenRimFacing(run_.completion, X_OG * c.p_W, X_OG.linear() * c.n_W, margin)))
             return SupportKind::kCompleted;
           if (c.n_W.z() < floor_cos && nearOpenEdge(m_.am->open_edges, c.p_W, margin))  // G: z up
             return SupportKind::kAreaBorder;

@@ -11,6 +11,7 @@
 
 #include "place_planner/infra/mesh_io.h"
 #include "place_planner/infra/scenes.h"
+#include "place_planner/model/completion.h"
 #include "place_planner/planner.h"
 #include "place_planner/validation/physics_validator.h"
 #include "place_planner/validation/suite.h"
@@ -67,6 +68,27 @@ TEST(Scans, BoxScannedFromAboveRestsOnASeenFace) {
     }
   const auto check = bullet(box, table, *c, cfg.friction);
   EXPECT_TRUE(check.confirmed) << "moved " << check.moved_m << " m, turned " << check.turned_deg << " deg";
+}
+
+// A contact on the rim of an open region needs unseen surface when the region faces the surface
+// it is on: the part never seen may bulge past that surface (a mug laid on the side the hand hid).
+// The box scanned from above: its open bottom faces down (O), its rim is the side walls' lower edges.
+TEST(Scans, ContactOnTheRimOfAnOpenRegionFacingItsSurfaceNeedsUnseenSurface) {
+  const Mesh scan = openBottomBox(scenes::box(0.08, 0.06, 0.04));
+  const Completion completion = completeOpenRegions(scan);
+  ASSERT_EQ(completion.caps.size(), 1u);
+  EXPECT_LT(completion.caps[0].normal.z(), -0.99) << "the cap faces down";
+  const Eigen::Vector3d corner(0.04, 0.03, -0.02), edge(0.0, 0.03, -0.02), top(0.0, 0.0, 0.02);
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), from_side = -Eigen::Vector3d::UnitY();
+  // On a table (its normal pushes up, against the cap): the rim's corner and edge need it.
+  EXPECT_TRUE(onOpenRimFacing(completion, corner, up, 0.003));
+  EXPECT_TRUE(onOpenRimFacing(completion, edge, up, 0.003));
+  // Against a wall beside it (the region faces away from the wall): seen surface.
+  EXPECT_FALSE(onOpenRimFacing(completion, edge, from_side, 0.003));
+  // Away from the rim: the rule is the cap's own (onCompletedSurface), not this one.
+  EXPECT_FALSE(onOpenRimFacing(completion, top, -up, 0.003));
+  EXPECT_FALSE(onOpenRimFacing(completion, Eigen::Vector3d(0, 0, -0.02), up, 0.003));
+  EXPECT_TRUE(onCompletedSurface(completion, Eigen::Vector3d(0, 0, -0.02), 0.003));
 }
 
 // With its sides seen, the box may stand on its completed bottom: allowed (stable), flagged.

@@ -57,4 +57,14 @@ Completion completeOpenRegions(const Mesh& object);
 // and farther than `margin` from the loop (the seen rim itself is seen).
 bool onCompletedSurface(const Completion& completion, const Eigen::Vector3d& p_O, double margin);
 
+// True when the contact p_O (normal n_O pointing at the object, frame O) lies within `margin` of
+// the rim of an open region that faces the surface the contact is on (its cap's outward normal
+// within 60 degrees of -n_O). The seen rim touches, but the unseen part inside it may bulge past
+// the surface: a mug whose side was hidden by the hand, laid on that side, rests on the rim in the
+// plan and on the bulge beyond the rim's chord in truth, and rolls. (The cap's own contacts are
+// onCompletedSurface's; a rim whose region faces sideways, a bottom's edge under a hidden side,
+// is not this.)
+bool onOpenRimFacing(const Completion& completion, const Eigen::Vector3d& p_O, const Eigen::Vector3d& n_O,
+                     double margin);
+
 }  // namespace place_planner

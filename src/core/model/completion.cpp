@@ -116,6 +116,19 @@ bool onCompletedSurface(const Completion& completion, const Eigen::Vector3d& p, 
   return false;
 }
 
+bool onOpenRimFacing(const Completion& completion, const Eigen::Vector3d& p, const Eigen::Vector3d& n,
+                     double margin) {
+  // Facing: the cap's outward normal within 60 degrees of the surface's (-n).
+  constexpr double kFacing = 0.5;
+  for (const CompletionCap& cap : completion.caps) {
+    if (cap.normal.dot(n) > -kFacing) continue;
+    const size_t k = cap.loop.size();
+    for (size_t i = 0; i < k; ++i)
+      if (segmentDistance(p, cap.loop[i], cap.loop[(i + 1) % k]) <= margin) return true;
+  }
+  return false;
+}
+
 bool nearOpenEdge(const std::vector<std::array<Eigen::Vector3d, 2>>& edges, const Eigen::Vector3d& p, double margin) {
   for (const auto& e : edges)
     if (segmentDistance(p, e[0], e[1]) < margin) return true;

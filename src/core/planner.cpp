@@ -116,7 +116,7 @@ std::vector<V3> findFloorPoints(const AreaModel& am, const PlannerConfig& config
 
 // What the tree steps need (Sections V, VI): models, backend, stability parameters.
 TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaModel& am, Backend& backend,
-                        const Radii& rad, const PlannerConfig& config, PlanStats& st) {
+                        const Radii& rad, const PlannerConfig& config, PlanStats& st, bool scanned) {
   // Support at least min_support_width wide, or a quarter of the object's middle extent.
   Eigen::Vector3d ext = object.properties.bounds_max - object.properties.bounds_min;
   std::sort(ext.data(), ext.data() + 3);
@@ -125,6 +125,7 @@ TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaMod
   TreeContext ctx{om, am, backend, sp, rad.cd, config.max_rotations, config.max_local_optimisation_steps,
                   config.threads, &st.steps, &st.tree_nodes};
   ctx.rock_settle = config.rock_settle;
+  ctx.shape_uncertainty = scanned ? config.scan_noise : 0.0;  // a scan's crests are its noise's
   return ctx;
 }
 
@@ -457,7 +458,8 @@ class TreeSearch {
       : run_(run),
         m_(m),
         roots_(r.floor_G, r.orientations, m.searched(run.object).properties, *m.am, m.d_vis, r.hanging),
-        ctx_(treeContext(m.searched(run.object), m.om, *m.am, *m.backend, m.rad, run.config, run.st())),
+        ctx_(treeContext(m.searched(run.object), m.om, *m.am, *m.backend, m.rad, run.config, run.st(),
+                         run.run_completion())),
         rp_(robustnessParams(run.config, run.run_completion())),
         // With the robustness check on, the search leaves a share of the budget for it.
         monitor_{m.om, *m.am, run.config, run.progress, run.t0,

@@ -93,6 +93,10 @@ struct TreeContext {
   // A stable pose is rocked about the horizontal axes through its centre of mass and moves
   // where a rock lowers it (rockStep); false: the static test decides alone.
   bool rock_settle = false;
+  // The object's shape uncertainty (m): a scan's noise (config.h scan_noise). The bottom of a
+  // roll holds only when its crests rise more than this too (rollStep): a crest the noise could
+  // have made, or flattened, is no evidence of a rest. 0: the mesh is taken as exact.
+  double shape_uncertainty = 0;
 };
 
 class TreeStepper {

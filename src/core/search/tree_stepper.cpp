@@ -638,7 +638,8 @@ void TreeStepper::rollStep() {
       n.roll = 0;
       n.X_GO = translated(q[i * kN + best].X_GO, v3(0, 0, -t[i * kN + best]));
     } else {
-      auto margin = [&](const Crest& c) { return c.rise < kMinRollRise ? 0.0 : c.angle; };
+      const double holding_rise = std::max(kMinRollRise, ctx_.shape_uncertainty);
+      auto margin = [&](const Crest& c) { return c.rise < holding_rise ? 0.0 : c.angle; };
       n.roll = 1;
       n.roll_margin = std::min(margin(cp), margin(cm));
       bottom[i] = best;

@@ -124,6 +124,34 @@ TEST(Hanging, MugHangsAtTheRootOfAMugTreesRisingArm) {
       << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
 }
 
+// A ring threaded on a mug tree's rising arm slides to the root, swings, and turns the last
+// degrees onto the post it leans on. That turn keeps its tree's peg: its perturbed releases
+// swing on the arm as the pose's did (without the peg they slid and failed: no robust pose).
+TEST(Hanging, RingLeansOnTheMugTreesPostAndStaysOnItsArm) {
+  const Mesh ring = scenes::byName("ring");
+  const Mesh tree = scenes::mugTree();
+  PlannerConfig c = twoThreads();
+  c.placement = PlacementKind::kHanging;
+  const PlanResult r = Planner().plan(ring, tree, c);
+  ASSERT_GT(r.stableCount(), 0) << "the ring hangs on no arm";
+  const Candidate& best = r.candidates.front();
+  ASSERT_TRUE(best.stable);
+  EXPECT_TRUE(best.hanging);
+  EXPECT_EQ(best.robustness.held, best.robustness.trials);
+  // On an arm (its root 1.2 cm from the post's axis, its tip 9 cm out): held from above there.
+  const Eigen::Vector3d com = best.X_WO * ring.properties.center_of_mass;
+  int above = 0;
+  for (const ContactPoint& p : best.contacts)
+    if (p.p_W.z() > com.z() + 0.01) {
+      ++above;
+      EXPECT_LT(p.p_W.head<2>().norm(), 0.012 + 0.09);
+    }
+  EXPECT_GT(above, 0);
+  const PoseCheck p = PhysicsValidator(ring, tree, damped()).check(best.X_WO);
+  EXPECT_TRUE(stillHanging(p, best.X_WO, ring.properties.center_of_mass, damped()))
+      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
+}
+
 // The YCB mug hung by its handle stays on its peg in Bullet. The validator cuts a looped object
 // into pieces no wider than its loop (ValidatorConfig::loop_sized_pieces); with 5 cm pieces
 // the handle's opening is bridged and Bullet pushes the mug off the peg (5-8 cm).

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <optional>
 
 #include "place_planner/infra/mesh_io.h"
 #include "place_planner/infra/scenes.h"
@@ -94,34 +95,51 @@ TEST(Hanging, MugWithHolesStillHangs) {
   expectHangsOnAPeg(mug, r);
 }
 
+// The best candidate of `object` on the built-in mug tree with placement hanging: stable and
+// hanging; none (a failure) when nothing stable hangs there.
+std::optional<Candidate> bestHungOnTheMugTree(const Mesh& object) {
+  PlannerConfig c = twoThreads();
+  c.placement = PlacementKind::kHanging;
+  const PlanResult r = Planner().plan(object, scenes::mugTree(), c);
+  EXPECT_GT(r.stableCount(), 0) << "it hangs on no arm";
+  if (r.stableCount() == 0 || !r.candidates.front().stable) return std::nullopt;
+  EXPECT_TRUE(r.candidates.front().hanging);
+  return r.candidates.front();
+}
+
+// Some contact above the centre of mass (held from above), and every such contact within
+// `reach` of the vertical axis through the area's origin (the mug tree's post).
+void expectHeldFromAboveWithin(const Mesh& object, const Candidate& best, double reach) {
+  const Eigen::Vector3d com = best.X_WO * object.properties.center_of_mass;
+  int above = 0;
+  for (const ContactPoint& p : best.contacts)
+    if (p.p_W.z() > com.z() + 0.01) {
+      ++above;
+      EXPECT_LT(p.p_W.head<2>().norm(), reach) << "held too far out along the arm";
+    }
+  EXPECT_GT(above, 0) << "nothing holds it from above";
+}
+
+// Bullet keeps the candidate hanging (released 2 mm above, lightly damped: stillHanging).
+void expectStillHangsInBullet(const Mesh& object, const Mesh& area, const Candidate& best) {
+  const PoseCheck p = PhysicsValidator(object, area, damped()).check(best.X_WO);
+  EXPECT_TRUE(stillHanging(p, best.X_WO, object.properties.center_of_mass, damped()))
+      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
+}
+
 // A mug tree's arms rise 25 degrees, past the friction angle (atan 0.2 = 11.3): hung on an arm,
 // the mug slides down it to the post. It is threaded on until it meets the post and hangs there,
 // its body leaning on the post below the arm; Bullet keeps it hanging.
 TEST(Hanging, MugHangsAtTheRootOfAMugTreesRisingArm) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
-  const Mesh tree = scenes::mugTree();
-  PlannerConfig c = twoThreads();
-  c.placement = PlacementKind::kHanging;
-  const PlanResult r = Planner().plan(mug, tree, c);
-  ASSERT_GT(r.stableCount(), 0) << "the mug hangs on no arm";
-  const Candidate& best = r.candidates.front();
-  ASSERT_TRUE(best.stable);
-  EXPECT_TRUE(best.hanging);
-  EXPECT_EQ(best.start, StartKind::kLoopOnPeg);
-  // Held from above by an arm: some contact above the centre of mass, within the arm's first
-  // 3 cm from the post (radius 12 mm), where it slid to.
-  const Eigen::Vector3d com = best.X_WO * mug.properties.center_of_mass;
-  int above = 0;
-  for (const ContactPoint& p : best.contacts)
-    if (p.p_W.z() > com.z() + 0.01) {
-      ++above;
-      EXPECT_LT(p.p_W.head<2>().norm(), 0.012 + 0.03) << "not at the arm's root";
-    }
-  EXPECT_GT(above, 0);
-  const PoseCheck p = PhysicsValidator(mug, tree, damped()).check(best.X_WO);
-  EXPECT_TRUE(stillHanging(p, best.X_WO, mug.properties.center_of_mass, damped()))
-      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
+  const std::optional<Candidate> best = bestHungOnTheMugTree(mug);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
+  // Held from above by an arm, within its first 3 cm from the post (radius 12 mm), where it
+  // slid to.
+  expectHeldFromAboveWithin(mug, *best, 0.012 + 0.03);
+  expectStillHangsInBullet(mug, scenes::mugTree(), *best);
 }
 
 // A ring threaded on a mug tree's rising arm slides to the root, swings, and turns the last
@@ -129,27 +147,12 @@ TEST(Hanging, MugHangsAtTheRootOfAMugTreesRisingArm) {
 // swing on the arm as the pose's did (without the peg they slid and failed: no robust pose).
 TEST(Hanging, RingLeansOnTheMugTreesPostAndStaysOnItsArm) {
   const Mesh ring = scenes::byName("ring");
-  const Mesh tree = scenes::mugTree();
-  PlannerConfig c = twoThreads();
-  c.placement = PlacementKind::kHanging;
-  const PlanResult r = Planner().plan(ring, tree, c);
-  ASSERT_GT(r.stableCount(), 0) << "the ring hangs on no arm";
-  const Candidate& best = r.candidates.front();
-  ASSERT_TRUE(best.stable);
-  EXPECT_TRUE(best.hanging);
-  EXPECT_EQ(best.robustness.held, best.robustness.trials);
-  // On an arm (its root 1.2 cm from the post's axis, its tip 9 cm out): held from above there.
-  const Eigen::Vector3d com = best.X_WO * ring.properties.center_of_mass;
-  int above = 0;
-  for (const ContactPoint& p : best.contacts)
-    if (p.p_W.z() > com.z() + 0.01) {
-      ++above;
-      EXPECT_LT(p.p_W.head<2>().norm(), 0.012 + 0.09);
-    }
-  EXPECT_GT(above, 0);
-  const PoseCheck p = PhysicsValidator(ring, tree, damped()).check(best.X_WO);
-  EXPECT_TRUE(stillHanging(p, best.X_WO, ring.properties.center_of_mass, damped()))
-      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
+  const std::optional<Candidate> best = bestHungOnTheMugTree(ring);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->robustness.held, best->robustness.trials);
+  // Held from above by an arm (its root 1.2 cm from the post's axis, its tip 9 cm out).
+  expectHeldFromAboveWithin(ring, *best, 0.012 + 0.09);
+  expectStillHangsInBullet(ring, scenes::mugTree(), *best);
 }
 
 // The YCB mug hung by its handle stays on its peg in Bullet. The validator cuts a looped object

@@ -218,13 +218,23 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
         const Eigen::Vector3d start = p - 1e-6 * n;
         depth = std::min(depth, rayDepth(m, start, -n, grid.near(start, start - reach * n), group));
       }
-    const double thickness = std::clamp(depth, 6.0 * c.margin, c.piece_thickness);
+    const double thickness = std::min(depth, c.piece_thickness);
+    // The hull is shrunk by both margins (object's and area's) below, but Bullet shrinks a hull
+    // by at most 0.45 of its inner radius (about half a slab's thickness): a thin slab keeps most
+    // of the margins, and a mug's 1.5 mm bottom rested 5-7 mm above the table (with thin slabs
+    // thickened to 6 margins it poked through). So the slab is inset here by what the shrink
+    // leaves, both faces: [inset, thickness - inset] with the shrink 0.225 of what remains
+    // making up the two margins; a wall thinner than 4 margins is a sheet at its middle (its
+    // sides then stand out by 2 margins less half the wall).
+    const double m2 = 2.0 * c.margin, sheet = 0.05 * c.margin;
+    double inset = std::max(0.0, (m2 - 0.225 * thickness) / 0.55);
+    if (thickness - 2.0 * inset < sheet) inset = 0.5 * (thickness - sheet);
     std::vector<Eigen::Vector3d> pts;
     for (int t : group)
       for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d& p = m.vertices[m.triangles[t][k]];
-        pts.push_back(p);
-        pts.push_back(p - thickness * n);
+        pts.push_back(p - inset * n);
+        pts.push_back(p - (thickness - inset) * n);
       }
     pieces.push_back(std::move(pts));
   }

@@ -157,7 +157,7 @@ TEST(Hanging, RingLeansOnTheMugTreesPostAndStaysOnItsArm) {
 
 // The YCB mug hung by its handle stays on its peg in Bullet. The validator cuts a looped object
 // into pieces no wider than its loop (ValidatorConfig::loop_sized_pieces); with 5 cm pieces
-// the handle's opening is bridged and Bullet pushes the mug off the peg (5-8 cm).
+// the handle's opening is bridged and Bullet pushes the mug off the peg (moved about 2 cm).
 TEST(Hanging, MugHangingOnAPegStaysInBullet) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
@@ -178,7 +178,7 @@ TEST(Hanging, MugHangingOnAPegStaysInBullet) {
   ValidatorConfig coarse = damped();
   coarse.loop_sized_pieces = false;
   const PoseCheck q = PhysicsValidator(mug, wall, coarse).check(best.X_WO);
-  EXPECT_GT(q.moved_m, 0.02) << "with its handle closed the mug should not stay on the peg";
+  EXPECT_GT(q.moved_m, coarse.max_translation) << "with its handle closed the mug should not stay on the peg";
 }
 
 }  // namespace

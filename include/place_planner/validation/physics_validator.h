@@ -12,7 +12,10 @@
 //    triangles of similar normal, thickened inwards up to `piece_thickness` (a GImpact mesh
 //    jitters on a triangle mesh; small hulls rest still), margins `margin` (1 mm: 0.5 mm gave
 //    wrong static friction), each hull shrunk by the two margins so that the true surfaces touch
-//    (a cube on a table rests at its geometric height, not 2 mm above), friction mu (Bullet multiplies the two coefficients: mu x 1.0);
+//    (a cube on a table rests at its geometric height, not 2 mm above; a piece too thin for
+//    Bullet's clamped shrink is inset by the rest, a wall thinner than 4 margins is a sheet at
+//    its middle: the YCB mug rests 1.3-1.5 mm high on its 1.5 mm bottom, 5-7 mm before),
+//    friction mu (Bullet multiplies the two coefficients: mu x 1.0);
 //  - mass = density x bounding-box volume, centred on the mesh's centre of mass c_O (the same
 //    surface centroid the planner uses), inertia of the solid bounding box about c_O;
 //  - the world simulated at `world_scale` (10) Bullet units per metre: lengths, margins and
@@ -53,7 +56,7 @@ struct ValidatorConfig {
   // An object with a loop (search/loops.h: a handle's opening, a ring's hole) is cut into pieces
   // no larger than its narrowest loop's radius, so that no piece's hull bridges the opening.
   // Measured: the YCB mug hung by its handle on a peg, with 5 cm pieces, was pushed off the peg
-  // (moved 5-8 cm); with pieces of its handle's radius it stays on it (moved 5 mm).
+  // (moved about 2 cm); with pieces of its handle's radius it stays on it.
   bool loop_sized_pieces = true;
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  // m/s^2, world frame
   // Bullet's velocity damping of the object (fraction of velocity lost per second, 0..1): a

@@ -443,8 +443,8 @@ int main(int argc, char** argv) {
       ->check(kFinite)
       ->capture_default_str();
   app.add_flag("--no-robust-check", no_robust_check, "static stability only (the paper)");
-  app.add_flag("--robust-recheck-caught", c.robust_recheck_caught,
-               "robustness: tilted releases caught where they land hold if that pose holds (peg tops; costs precision)");
+  app.add_flag("--robust-recheck-caught,!--no-robust-recheck-caught", c.robust_recheck_caught,
+               "robustness: tilted releases caught where they land hold if that pose holds (default on; peg tops, cups)");
   app.add_flag("--rock-settle,!--no-rock-settle", c.rock_settle,
                "stable poses rocked to the bottom of their rock (default on; racks, cups, trays)");
   app.add_option("--budget-ms", c.time_budget_ms, "time budget [ms], 0 = none")->check(kFinite)->capture_default_str();

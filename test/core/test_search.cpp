@@ -526,7 +526,7 @@ TEST(Stability, ContactsFromAboveNeverHold) {
   EXPECT_TRUE(evaluateStability(c, Eigen::Vector3d(0, 0, 0.075), StabilityParams{}).stable);
 }
 
-// The caught rule (RobustnessParams::recheck_caught, off by default) must not let a tilted
+// The caught rule (RobustnessParams::recheck_caught, on in the planner's defaults) must not let a tilted
 // release on a flat table count as caught: there the board comes back flat, 12 / 12 either way,
 // and the rule's end-pose recheck is never needed.
 TEST(Robustness, CaughtRuleKeepsFlatTableStrict) {

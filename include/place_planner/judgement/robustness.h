@@ -33,7 +33,8 @@ struct RobustnessParams {
   double end_roll_move = 0.003;
   // A tilted trial caught where it landed (stable, turned at most caught_angle from the pose)
   // also holds when that end pose holds its own shift and centre-of-mass trials.
-  // Off by default (PlannerConfig::robust_recheck_caught): on the 1k scenes it added 4 rack
+  // Off in a bare RobustnessParams, on in PlannerConfig::robust_recheck_caught's default. Earlier
+  // measured against Bullet at 1 unit per metre: on the 1k scenes it added 4 rack
   // scenes to the coverage but took the Bullet-confirmed precision from 0.978 to 0.946
   // (cracker, sugar and pudding boxes near the rack's edge pass it and slide in Bullet).
   bool recheck_caught = false;

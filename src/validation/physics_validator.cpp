@@ -161,6 +161,9 @@ double rayDepth(const Mesh& m, const Eigen::Vector3d& p, const Eigen::Vector3d& 
   return best;
 }
 
+// btConvexHullComputer shrinks a hull by at most this share of its inner radius.
+constexpr double kShrinkClamp = 0.45;
+
 // Groups neighbouring triangles (sharing an edge) of similar normal into pieces; each piece
 // becomes the point set of a convex slab: its vertices plus the same moved inwards (against the
 // piece's area-weighted normal) by a thickness (piece_thickness, or less where the opposite
@@ -181,7 +184,7 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
   }
   const std::vector<std::vector<int>> nbr = triangleNeighbours(m);
   // The thickness is clamped to piece_thickness below: only triangles within that reach matter.
-  const double reach = std::max(c.piece_thickness, 6.0 * c.margin);
+  const double reach = c.piece_thickness;
   TriangleGrid grid(m, reach);
 
   const double cos_max = std::cos(c.piece_max_normal_deg * M_PI / 180.0);
@@ -220,14 +223,14 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
       }
     const double thickness = std::min(depth, c.piece_thickness);
     // The hull is shrunk by both margins (object's and area's) below, but Bullet shrinks a hull
-    // by at most 0.45 of its inner radius (about half a slab's thickness): a thin slab keeps most
-    // of the margins, and a mug's 1.5 mm bottom rested 5-7 mm above the table (with thin slabs
-    // thickened to 6 margins it poked through). So the slab is inset here by what the shrink
-    // leaves, both faces: [inset, thickness - inset] with the shrink 0.225 of what remains
-    // making up the two margins; a wall thinner than 4 margins is a sheet at its middle (its
-    // sides then stand out by 2 margins less half the wall).
-    const double m2 = 2.0 * c.margin, sheet = 0.05 * c.margin;
-    double inset = std::max(0.0, (m2 - 0.225 * thickness) / 0.55);
+    // by at most kShrinkClamp of its inner radius (about half a slab's thickness): a thin slab
+    // keeps most of the margins, and a mug's 1.5 mm bottom rested 5-7 mm above the table (with
+    // thin slabs thickened to 6 margins it poked through). So the slab is inset here by what
+    // the shrink leaves, both faces: [inset, thickness - inset], the shrink (kShrinkClamp / 2 of
+    // what remains) making up the two margins; a wall thinner than 4 margins is a sheet at its
+    // middle (its sides then stand out by 2 margins less half the wall).
+    const double m2 = 2.0 * c.margin, sheet = 0.05 * c.margin, share = 0.5 * kShrinkClamp;
+    double inset = std::max(0.0, (m2 - share * thickness) / (1.0 - 2.0 * share));
     if (thickness - 2.0 * inset < sheet) inset = 0.5 * (thickness - sheet);
     std::vector<Eigen::Vector3d> pts;
     for (int t : group)
@@ -416,7 +419,7 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
       for (int k = 0; k < 3; ++k) xyz.push_back(S * (p[k] - d.c_O[k]));
     btConvexHullComputer ch;
     ch.compute(xyz.data(), 3 * sizeof(double), static_cast<int>(pts.size()),
-               btScalar(2.0 * S * config.margin), btScalar(0.45));
+               btScalar(2.0 * S * config.margin), btScalar(kShrinkClamp));
     if (ch.vertices.size() < 4) continue;
     auto hull = std::make_unique<btConvexHullShape>();
     for (int k = 0; k < ch.vertices.size(); ++k) hull->addPoint(ch.vertices[k], false);

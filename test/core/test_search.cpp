@@ -526,9 +526,9 @@ TEST(Stability, ContactsFromAboveNeverHold) {
   EXPECT_TRUE(evaluateStability(c, Eigen::Vector3d(0, 0, 0.075), StabilityParams{}).stable);
 }
 
-// The caught rule (RobustnessParams::recheck_caught, on in the planner's defaults) must not let a tilted
-// release on a flat table count as caught: there the board comes back flat, 12 / 12 either way,
-// and the rule's end-pose recheck is never needed.
+// The caught rule (RobustnessParams::recheck_caught, on in the planner's defaults) must not
+// let a tilted release on a flat table count as caught: there the board comes back flat,
+// 12 / 12 either way, and the rule's end-pose recheck is never needed.
 TEST(Robustness, CaughtRuleKeepsFlatTableStrict) {
   const Mesh board = scenes::box(0.10, 0.10, 0.01);
   const Mesh table = scenes::box(0.5, 0.5, 0.02, {0, 0, -0.01});

@@ -17,6 +17,9 @@ namespace place_planner {
 struct ContactPoint {
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  // position
   Eigen::Vector3d n_W = Eigen::Vector3d::UnitZ(); // unit normal, pointing at the object
+  // The area's own normal there, pointing at the object (n_W blends it with the object's); zero
+  // when not known. A wall's is horizontal where the object's edge meets it.
+  Eigen::Vector3d n_area_W = Eigen::Vector3d::Zero();
 };
 
 // How a stable pose holds when it is released a little off it (robustness.cpp): each trial

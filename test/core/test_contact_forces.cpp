@@ -130,6 +130,27 @@ TEST(ContactForces, HangingObjectLeansOnAWallBelowItsPeg) {
   EXPECT_FALSE(evaluateStability(wall, Eigen::Vector3d(0, 0, 0), sp).hanging);
 }
 
+// A loop hung on a ridge of a faceted peg (along x) touches both facets there, whose normals
+// lean 40 degrees either way; a wall at +y below. Its centre of mass 15 mm off straight below
+// the ridge, away from the wall: the wall pushes it with 0.3 of its weight, which the two
+// facets take together. Merged into one contact with their mean normal (straight up), friction
+// alone (mu 0.2) could not: the force model keeps contacts of unlike normals apart.
+TEST(ContactForces, ALoopsContactsOnBothFacetsOfItsPegKeepTheirNormals) {
+  StabilityParams sp;  // mu 0.2
+  const double a = 40 * M_PI / 180;
+  std::vector<ContactPoint> c;
+  for (double x : {-0.003, 0.003})
+    for (double side : {-1.0, 1.0}) c.push_back({{x, 0, 0}, {0, side * std::sin(a), std::cos(a)}});
+  c.push_back({{0, 0.03, -0.05}, {0, -1, 0}});
+  const Stability s = evaluateStability(c, Eigen::Vector3d(0, -0.015, -0.04), sp);
+  EXPECT_TRUE(s.hanging);
+  EXPECT_TRUE(s.stable) << "held by both facets and the wall";
+  // A ridge with both facets leaning the same way (one cone, tilted) does not hold it.
+  for (auto& p : c)
+    if (p.n_W.z() > 0) p.n_W = Eigen::Vector3d(0, -std::sin(a), std::cos(a));
+  EXPECT_FALSE(evaluateStability(c, Eigen::Vector3d(0, -0.015, -0.04), sp).stable);
+}
+
 // A 4 cm box whose lower edges touch two walls at `wall_deg` from the horizontal (a V-groove).
 std::vector<ContactPoint> vGroove(double wall_deg, bool both_walls) {
   const double a = wall_deg * M_PI / 180.0;

@@ -127,3 +127,22 @@ TEST(Kernels, ContactCullingKeepsEveryContact) {
   }
   EXPECT_GT(touching, 3);  // the poses do touch the rack
 }
+
+// A wall's normal keeps its side where the object faces it, wherever the centre of mass lies:
+// a ring round a post 24 mm thick has its centre of mass inside the post, and the post pushes
+// the ring out (sphereContact turns other normals towards the centre of mass). Above the
+// contact or below it, the same.
+TEST(Kernels, AWallFacingTheObjectPushesItOutEvenWithTheCentreOfMassBehindIt) {
+  const AreaModel am = buildAreaModel(scenes::cylinder(0.012, 0.36, 16), {0, 0, -1}, 0.00225, 0.00375, 0.00375);
+  const AreaView a = view(am);
+  // The ring's inner face touching the post's vertical edge at -x, facing +x (at the post).
+  const V3 s = v3(-0.0121, 0, 0.05), n_in = v3(1, 0, 0);
+  for (const double com_z : {0.04, 0.06}) {
+    const SphereContact inside = sphereContact(a, s, n_in, v3(0.002, 0, com_z));
+    ASSERT_TRUE(inside.valid);
+    EXPECT_LT(inside.n.x, -0.9) << "centre of mass inside the post, " << (com_z > 0.05 ? "above" : "below");
+    const SphereContact outside = sphereContact(a, s, n_in, v3(-0.03, 0, com_z));
+    ASSERT_TRUE(outside.valid);
+    EXPECT_LT(outside.n.x, -0.9) << "centre of mass beside the post";
+  }
+}

@@ -95,6 +95,31 @@ TEST(Hanging, MugWithHolesStillHangs) {
   expectHangsOnAPeg(mug, r);
 }
 
+// Coat pegs rising 10 degrees (under the friction angle, atan 0.2): the YCB mug hangs by its
+// handle at a peg's root, its body leaning on the wall below the peg (the wall's face at
+// y = 0.09). Every perturbed release holds, and Bullet keeps it hanging. The wall's contacts
+// push sideways along the wall's own normal; merged with the peg's into one mean normal, or
+// blended with the mug's, they read as a floor or lose the peg's grip, and nothing held.
+TEST(Hanging, MugHangsOnRisingPegsLeaningOnTheWall) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh wall = scenes::pegWall(10.0);
+  const PlanResult r = Planner().plan(mug, wall, twoThreads());
+  ASSERT_FALSE(r.candidates.empty());
+  const Candidate& best = r.candidates.front();
+  ASSERT_TRUE(best.stable) << "no stable candidate";
+  EXPECT_TRUE(best.hanging);
+  EXPECT_EQ(best.start, StartKind::kLoopOnPeg);
+  EXPECT_EQ(best.robustness.held, best.robustness.trials);
+  const Eigen::Vector3d com = best.X_WO * mug.properties.center_of_mass;
+  int on_wall = 0;
+  for (const ContactPoint& c : best.contacts) on_wall += c.p_W.y() > 0.088 && c.p_W.z() < com.z() + 0.003;
+  EXPECT_GT(on_wall, 0) << "its body does not lean on the wall";
+  const PoseCheck p = PhysicsValidator(mug, wall, damped()).check(best.X_WO);
+  EXPECT_TRUE(stillHanging(p, best.X_WO, mug.properties.center_of_mass, damped()))
+      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
+}
+
 // The best candidate of `object` on the built-in mug tree with placement hanging: stable and
 // hanging; none (a failure) when nothing stable hangs there.
 std::optional<Candidate> bestHungOnTheMugTree(const Mesh& object) {

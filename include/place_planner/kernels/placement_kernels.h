@@ -351,6 +351,7 @@ struct SphereContact {
   V3 p;       // p_c: mean of the colliding area spheres
   V3 n;       // contact normal, pointing at the object
   int valid;  // 0: no area sphere within the collision distance
+  V3 na{0, 0, 0};  // the area's own normal there (its spheres' mean), pointing at the object; 0: unknown
 };
 
 // Contact of one object sphere (centre s_G, outward normal n_G, both posed) with the area via
@@ -358,9 +359,10 @@ struct SphereContact {
 // colliding area spheres. The normal blends the area's normals and the object's inward normal:
 // the paper's d_c = s - p_c is ill-defined when the two surfaces are coplanar, as in every
 // face-on-face contact. Each is turned to point at the object's centre of mass (com_G), except
-// under a contact above the centre of mass where an area normal and the object's inward normal
-// agree (both meshes wound outward there): a ring hanging on a peg has its centre of mass
-// across the peg from the contact, and the peg pushes it up.
+// where an area normal faces the object's outward one (both meshes wound outward there) above
+// the centre of mass, or on a wall (the area normal within kAgree of horizontal): a ring hanging
+// on a peg has its centre of mass across the peg from the contact, and the peg pushes it up; a
+// ring round a post has its centre of mass inside the post, and the post pushes it out.
 PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G) {
   SphereContact out{v3(0, 0, 0), v3(0, 0, 1), 0};
   const GridView& g = area.grid;
@@ -392,8 +394,8 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
     if (a.z <= s_G.z - g.collision_distance) break;
     if (norm2(a - s_G) >= cd2) continue;
     V3 na = area.mesh.sphere_normals[i];
-    const bool hangs_here = com_G.z < a.z && dot(na, n_G) < -kAgree;
-    if (!hangs_here && dot(na, com_G - a) < 0) na = -na;
+    const bool faces = (com_G.z < a.z || fabs(na.z) < kAgree) && dot(na, n_G) < -kAgree;
+    if (!faces && dot(na, com_G - a) < 0) na = -na;
     sum = sum + a;
     nsum = nsum + na;
     ++count;
@@ -411,9 +413,11 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   out.p = (1.0 / count) * sum;
   V3 no = -n_G;
   const V3 nmean = (1.0 / count) * nsum;
-  const bool agree = com_G.z < out.p.z && dot(nmean, no) > kAgree * sqrt(norm2(nmean));
+  const double nm = sqrt(norm2(nmean));
+  const bool agree = (com_G.z < out.p.z || fabs(nmean.z) < kAgree * nm) && dot(nmean, no) > kAgree * nm;
   if (!agree && dot(no, com_G - s_G) < 0) no = -no;
   V3 n = nmean + no;
+  if (norm2(nmean) > 1e-12) out.na = normalized(nmean);
   if (norm2(n) < 1e-12) n = s_G - out.p;
   if (!agree && dot(n, com_G - out.p) < 0) n = -n;
   out.n = normalized(n);

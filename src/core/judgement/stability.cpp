@@ -125,11 +125,32 @@ Eigen::Vector3d farthest(const std::vector<ContactPoint>& c, const Eigen::Vector
 
 // The contacts merged (reduceContacts) in cells of an eighth of their extent (at least the
 // contact tolerance): a few dozen at most, so the NNLS stays small whatever the sphere model's
-// density.
+// density. Only contacts whose normals lie within kMergeNormal of each other merge: a loop's
+// contacts fan round its peg, and one mean normal in their place keeps one friction cone of
+// the several that grip the peg together (a mug hung against a wall lost its balance so,
+// depending on where the cells fell).
+constexpr double kMergeNormal = 30 * M_PI / 180;
 std::vector<ContactPoint> forceContacts(const std::vector<ContactPoint>& contacts, const StabilityParams& prm) {
   double extent = 0;
   for (const ContactPoint& p : contacts) extent = std::max(extent, (p.p_W - contacts.front().p_W).norm());
-  return reduceContacts(contacts, std::max(prm.tol, extent / 8));
+  // Greedy groups by normal, each merged on its own.
+  std::vector<Eigen::Vector3d> seeds;
+  std::vector<std::vector<ContactPoint>> groups;
+  for (const ContactPoint& p : contacts) {
+    size_t g = 0;
+    while (g < seeds.size() && p.n_W.dot(seeds[g]) < std::cos(kMergeNormal)) ++g;
+    if (g == seeds.size()) {
+      seeds.push_back(p.n_W);
+      groups.emplace_back();
+    }
+    groups[g].push_back(p);
+  }
+  std::vector<ContactPoint> out;
+  for (const auto& group : groups) {
+    const std::vector<ContactPoint> merged = reduceContacts(group, std::max(prm.tol, extent / 8));
+    out.insert(out.end(), merged.begin(), merged.end());
+  }
+  return out;
 }
 
 // The contact forces (contact_forces.h) on the merged contacts.
@@ -155,6 +176,13 @@ bool slides(Stability& r, const Eigen::Vector3d& slip) {
   return true;
 }
 
+// A contact that only pushes sideways: the area's own normal there (where known) within
+// kSideContact of horizontal.
+bool sideContact(const ContactPoint& p) {
+  const Eigen::Vector3d& n = p.n_area_W.squaredNorm() > 0 ? p.n_area_W : p.n_W;
+  return std::abs(n.dot(kUp)) < kSideContact;
+}
+
 // Hanging: the contact forces, inside their friction cones, balance gravity (the centre of mass
 // straight below the support). A ring on a peg sloping down past atan mu slides off.
 Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
@@ -170,6 +198,9 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
   // to 45 degrees, past the friction cone), though the bar rests on the ridge. Contacts on
   // surfaces facing different ways (a peg and a wall) keep their own.
   std::vector<ContactPoint> support = contacts;
+  // A wall below the centre of mass pushes along its own normal (sideContact).
+  for (auto& p : support)
+    if (p.p_W.z() <= com.z() + prm.tol && p.n_area_W.squaredNorm() > 0) p.n_W = p.n_area_W;
   bool one_support = nbar.norm() > 1e-9;
   for (const auto& p : contacts) one_support = one_support && p.n_W.dot(nbar.normalized()) >= 0.5;
   if (one_support)
@@ -259,10 +290,12 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   // Below the centre of mass only side contacts (a wall the hanging object leans on, normals
   // within kSideContact of horizontal), nothing that holds it up from below.
   // And a support above it that pushes up (a wall alone holds nothing up).
+  // Below it, the area's own normal tells a wall (sideContact): the blended one leans up where
+  // the object's rim or bottom edge meets the wall.
   bool hangs = true, held_above = false;
   Eigen::Vector3d up_push = Eigen::Vector3d::Zero();
   for (const auto& p : contacts) {
-    if (p.p_W.z() <= com.z() + prm.tol) hangs = hangs && std::abs(p.n_W.dot(kUp)) < kSideContact;
+    if (p.p_W.z() <= com.z() + prm.tol) hangs = hangs && sideContact(p);
     else held_above = held_above || p.n_W.dot(kUp) >= kSideContact;
     up_push += p.n_W;
   }

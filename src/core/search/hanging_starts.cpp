@@ -41,10 +41,12 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
           front = std::max(front, s);
         }
         // Along the peg: in the middle of the room between the object clear of the base (by a
-        // collision distance and a millimetre) and the loop a thickness short of the tip, so a
-        // swing or a push meets neither.
+        // collision distance and a millimetre) and the loop's far side short of the tip by half
+        // its thickness (at most 1 cm: a roll of tape's 5 cm need not be), so a swing or a push
+        // meets neither.
         const double length = peg.to_base + peg.to_tip;
-        const double nearest = back + cd + 0.001, farthest = length - loop.thickness;
+        const double nearest = back + cd + 0.001,
+                     farthest = length - 0.5 * loop.thickness - std::min(0.5 * loop.thickness, 0.01);
         if (nearest > farthest) continue;
         const double along = 0.5 * (nearest + farthest);
         const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis;

@@ -49,6 +49,30 @@ bool roomBelowInGrid(const AreaModel& am, const Eigen::Vector3d& top, const PegP
   return true;
 }
 
+// How far a peg's end reaches past the first surface its axis meets at `tip` (a ball knob on
+// its end, or an end face left inside a knob where a mesh's parts overlap): each next surface
+// within max_thickness ahead counts while the space before it is a knob's inside (rays across
+// the axis from its middle all meet the area within a knob's radius, 3 half widths of the peg
+// and 2 mm). A gap in the open (a wall just beyond the tip) is not enclosed, and a post the peg
+// runs into is longer than a knob: the peg ends there, not free.
+double knobBeyond(const AreaModel& am, Eigen::Vector3d tip, const Eigen::Vector3d& a, const Eigen::Vector3d& side,
+                  double half, double max_thickness) {
+  constexpr double kStep = 2e-4;
+  const Eigen::Vector3d up = a.cross(side).normalized();
+  const double knob = 3 * half + 0.002;
+  double beyond = 0;
+  while (beyond < max_thickness) {
+    const double s = ray(am, tip, a, max_thickness - beyond);
+    if (s >= max_thickness - beyond) break;
+    const Eigen::Vector3d mid = tip + 0.5 * s * a;
+    for (const Eigen::Vector3d& d : {side, Eigen::Vector3d(-side), up, Eigen::Vector3d(-up)})
+      if (ray(am, mid, d, knob) >= knob) return beyond;
+    beyond += s + kStep;
+    tip += (s + kStep) * a;
+  }
+  return beyond;
+}
+
 }  // namespace
 
 std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSignal* stop) {
@@ -77,7 +101,7 @@ std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSig
     const double t = ray(am, top - kEps * up, -up, p.max_thickness);
     if (t >= p.max_thickness || t < 1e-3) continue;
     if (ray(am, top - (t + 2 * kEps) * up, -up, p.min_free_below) < p.min_free_below) continue;
-    const Eigen::Vector3d c = top - (kEps + 0.5 * t) * up;
+    Eigen::Vector3d c = top - (kEps + 0.5 * t) * up;
     // The axis: the horizontal direction the part is longest in, then its slope in that plane.
     // Every 30 degrees first: one of those is within 15 degrees of across a peg, where its span
     // is under 1.04 times its width; a slab (a book overhanging the one below) is wide every way.
@@ -93,9 +117,14 @@ std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSig
     }
     if (narrowest > 1.04 * p.max_thickness) continue;
     const Eigen::Vector3d side = up.cross(axis).normalized();
-    const Span across = span(am, c, side);
+    Span across = span(am, c, side);
     const double width = across.total();
     if (width > p.max_thickness) continue;  // a board, a table top: wide
+    // Onto the axis across the peg: a faceted peg's top triangle lies off to one side, and
+    // samples off it by different amounts along the peg would skew the axis fitted through them
+    // (below), whose span then leaves the peg through its side long before its tip.
+    c += 0.5 * (across.ahead - across.behind) * side;
+    across.ahead = across.behind = 0.5 * width;
     // Free all round: beside it at its middle (room for a loop's side), and below it beside its
     // bottom on both sides (the rim of a wall, a cover's edge, a scan's crease have more of the
     // area right below one side).
@@ -107,18 +136,23 @@ std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSig
                    ray(am, c + (out + 0.002) * s * side - 0.5 * t * up, -up, p.min_free_below) >= p.min_free_below;
     }
     if (!free_round) continue;
-    // Its slope in 10 degree steps, then azimuth and slope in 2.5 degree steps about the best:
-    // off the axis by d, a ray leaves a peg of half width w through its side after w / sin d.
-    const double azimuth = std::atan2(axis.y(), axis.x());
+    // Its slope in 10 degree steps at every 30 degrees of azimuth (a steep arm's horizontal
+    // spans are all short, and the longest of them need not lie along it), then azimuth and
+    // slope in 2.5 degree steps about the best: off the axis by d, a ray leaves a peg of half
+    // width w through its side after w / sin d.
+    double azimuth = std::atan2(axis.y(), axis.x());
     auto direction = [&](double az, double el) {
       return Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     };
     double slope = 0;
     const int slopes = static_cast<int>(p.max_slope_deg / 10);
-    for (int k = -slopes; k <= slopes; ++k) {
-      const double len = span(am, c, direction(azimuth, k * 10.0 * M_PI / 180)).total();
-      if (len > longest + 1e-6) longest = len, slope = k * 10.0 * M_PI / 180;
-    }
+    for (int i = 0; i < 12; ++i)
+      for (int k = -slopes; k <= slopes; ++k) {
+        if (k == 0) continue;  // the horizontal ones are measured
+        const double az = M_PI * i / 12;  // a span runs both ways: half a turn covers them
+        const double len = span(am, c, direction(az, k * 10.0 * M_PI / 180)).total();
+        if (len > longest + 1e-6) longest = len, slope = k * 10.0 * M_PI / 180, azimuth = az;
+      }
     double best_az = azimuth, best_el = slope;
     const double fine = 2.5 * M_PI / 180;
     for (int i = -4; i <= 4; ++i)
@@ -129,6 +163,9 @@ std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSig
         if (len > longest + 1e-6) longest = len, best_az = azimuth + i * fine, best_el = el;
       }
     axis = direction(best_az, best_el);
+    // A top lies along the peg's side: an end face (a cap of an arm rising past 30 degrees faces
+    // up enough to be probed) is not one, and its samples would make a peg pointing back.
+    if (std::abs(toEigen(am.triangle_normals[tops[s]]).dot(axis)) > 0.5) continue;
     const double half = 0.5 * std::max(t, width);
     if (longest < 5.0 * half) continue;  // a knob, not a peg
     // As thin a third of the way from either end (a corner of a board is thin near its tip only).
@@ -142,7 +179,9 @@ std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSig
     // Its free end: beyond it nothing along the axis for min_tip_free.
     for (const double sign : {1.0, -1.0}) {
       const Eigen::Vector3d a = sign * axis;
-      const double to_tip = sign > 0 ? sp.ahead : sp.behind, to_base = sign > 0 ? sp.behind : sp.ahead;
+      double to_tip = sign > 0 ? sp.ahead : sp.behind;
+      const double to_base = sign > 0 ? sp.behind : sp.ahead;
+      to_tip += knobBeyond(am, c + (to_tip + 2 * kEps) * a, a, side, half, p.max_thickness);
       const Eigen::Vector3d tip = c + (to_tip + 2 * kEps) * a;
       if (ray(am, tip, a, p.min_tip_free) < p.min_tip_free) continue;
       if (sign < 0 && ray(am, c + (sp.ahead + 2 * kEps) * axis, axis, p.min_tip_free) >= p.min_tip_free)
@@ -182,8 +221,10 @@ std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSig
     if (spread > 2 * best.half_width && std::abs(fitted.dot(best.axis)) > std::cos(20 * M_PI / 180)) {
       if (fitted.dot(best.axis) < 0) fitted = -fitted;
       const Span sp = span(am, best.point, fitted);
+      const Eigen::Vector3d side = Eigen::Vector3d::UnitZ().cross(fitted).normalized();
       best.axis = fitted;
-      best.to_tip = sp.ahead;
+      best.to_tip = sp.ahead + knobBeyond(am, best.point + (sp.ahead + 2 * kEps) * fitted, fitted, side,
+                                          best.half_width, p.max_thickness);
       best.to_base = sp.behind;
     }
     pegs.push_back(best);

@@ -106,6 +106,30 @@ TEST(Loops, AHandlesOpeningAndARingsHoleAreFoundSolidsHaveNone) {
 
 // The choice of placement kind: standing only drops the hanging poses; hanging only on a table
 // says why nothing hangs; the mug's best pose on a table is the same with any kind allowed.
+// A roll of tape: a hole 7.6 cm across through a loop 4.8 cm deep, on the knobbed 8 cm pegs of
+// the wall mug rack. Threaded with half its depth to spare (a whole depth short of the tip
+// left no room on the peg), it hangs round a peg, its centre of mass below the peg's axis.
+TEST(Placement, ARollOfTapeHangsOnAKnobbedPeg) {
+  PlannerConfig c;
+  c.threads = 2;
+  c.placement = PlacementKind::kHanging;
+  const Mesh tape = scenes::byName("tape_roll");
+  const PlanResult r = Planner().plan(tape, scenes::mugRack(), c);
+  ASSERT_GT(r.stableCount(), 0);
+  const Candidate& best = r.candidates.front();
+  ASSERT_TRUE(best.hanging);
+  const Eigen::Vector3d com = best.X_WO * tape.properties.center_of_mass;
+  // Below one of the four pegs (x = -0.18, -0.06, 0.06, 0.18; axes 4 to 10 cm high over z = 0.4
+  // along the first 8 cm of -y), within the hole's radius of its axis.
+  double nearest = 1;
+  for (const double x : {-0.18, -0.06, 0.06, 0.18}) nearest = std::min(nearest, std::abs(com.x() - x));
+  EXPECT_LT(nearest, 0.01);
+  EXPECT_LT(com.z(), 0.4);
+  EXPECT_GT(com.z(), 0.4 - 0.038);
+  EXPECT_LT(com.y(), 0.0);
+  EXPECT_GT(com.y(), -0.085);
+}
+
 TEST(Placement, KindChoosesStandingOrHanging) {
   const Mesh ring = scenes::torus(0.03, 0.006);
   PlannerConfig c;

@@ -24,6 +24,8 @@ Mesh plane(double size_x, double size_y, double tilt_deg = 0.0);
 Mesh vTrough(double size, double angle_deg);
 // Closed torus about z: ring radius R, tube radius r, outward CCW (a napkin ring, a roll of tape).
 Mesh torus(double R, double r, int segments = 48, int sides = 12);
+// Closed tube about z from z = 0 to h: radii r_in and r_out, outward CCW (a roll of tape).
+Mesh tube(double r_in, double r_out, double h, int segments = 32);
 // Appends b to a (vertices re-indexed); the result is rebuilt and validated.
 Mesh merge(const std::vector<Mesh>& parts, const std::string& name = "merged");
 
@@ -43,6 +45,10 @@ Mesh shelfUnit(int subdivisions = 12);
 Mesh pegWall(double rise_deg = 0.0);
 // A mug tree: a foot 0.2 m across, a post and four arms rising 25 degrees at two heights.
 Mesh mugTree();
+// A wall mug rack: a board 0.5 m wide and only 12 cm tall (its face at y = 0) with four pegs
+// 8 mm thick and 8 cm long rising 15 degrees towards -y, each with a knob on its end. What
+// hangs from a peg reaches below the board.
+Mesh mugRack();
 // Demo objects (mesh frame at their base centre, like a scan).
 Mesh mug();           // cylinder body with a handle, 0.08 m diameter
 Mesh plate();         // flat disc 0.24 m, 2 cm thick rim
@@ -50,7 +56,8 @@ Mesh pen();           // thin cylinder 0.14 m long
 Mesh loopMug();       // the mug with a handle it can hang by: an opening 5.8 x 2.4 cm
 
 // Names accepted by byName(): table, dish_rack, open_box, binder_stack, shelf, peg_wall,
-// peg_wall_rising (its pegs rising 10 degrees), mug_tree, mug, loop_mug, ring (torus 6 cm across, 12 mm thick), plate, pen, cube.
+// peg_wall_rising (its pegs rising 10 degrees), mug_tree, mug_rack, mug, loop_mug, ring (torus 6 cm
+// across, 12 mm thick), tape_roll (tube 11 cm across, a hole 7.6 cm across, 4.8 cm deep), plate, pen, cube.
 Mesh byName(const std::string& name);
 std::vector<std::string> areaNames();
 std::vector<std::string> objectNames();

@@ -191,6 +191,41 @@ Mesh mugTree() {
   return b.build("mug_tree");
 }
 
+Mesh mugRack() {
+  Builder b;
+  b.add(box(0.5, 0.02, 0.12, {0, 0.01, 0.4}));
+  // Four pegs 8 mm thick and 8 cm long, rising 15 degrees towards -y, 12 cm apart, each with a
+  // knob on its end (a part of its own, overlapping the peg's end).
+  const double rise = 15 * M_PI / 180;
+  const Eigen::Vector3d d(0, -std::cos(rise), std::sin(rise));
+  const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), d).toRotationMatrix();
+  for (const double x : {-0.18, -0.06, 0.06, 0.18}) {
+    b.add(cylinder(0.004, 0.08, 16), R, Eigen::Vector3d(x, 0, 0.4) + 0.04 * d);
+    b.add(cylinder(0.007, 0.008, 16), R, Eigen::Vector3d(x, 0, 0.4) + 0.08 * d);
+  }
+  return b.build("mug_rack");
+}
+
+Mesh tube(double r_in, double r_out, double h, int segments) {
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::vector<int>> f;
+  for (int i = 0; i < segments; ++i) {
+    const double a = 2 * M_PI * i / segments, c = std::cos(a), s = std::sin(a);
+    for (const double r : {r_out, r_in})
+      for (const double z : {0.0, h}) v.emplace_back(r * c, r * s, z);
+  }
+  // Per segment: outer bottom, outer top, inner bottom, inner top (4 i + 0..3); quads wound
+  // outwards (the inner wall's outside faces the hole).
+  for (int i = 0; i < segments; ++i) {
+    const int a = 4 * i, b = 4 * ((i + 1) % segments);
+    f.push_back({a, b, b + 1, a + 1});          // outer wall
+    f.push_back({a + 2, a + 3, b + 3, b + 2});  // inner wall
+    f.push_back({a + 1, b + 1, b + 3, a + 3});  // top
+    f.push_back({a, a + 2, b + 2, b});          // bottom
+  }
+  return buildMesh(v, f, "tube");
+}
+
 Mesh mug() {
   Builder b;
   const Mesh body = cylinder(0.04, 0.1, 24);
@@ -252,9 +287,11 @@ Mesh byName(const std::string& n) {
   if (n == "mug_tree") return mugTree();
   if (n == "loop_mug") return loopMug();
   if (n == "ring") return torus(0.03, 0.006);
+  if (n == "mug_rack") return mugRack();
+  if (n == "tape_roll") return tube(0.038, 0.055, 0.048);
   if (n == "cube") return box(0.1, 0.1, 0.1, {0, 0, 0.05});
   throw std::invalid_argument("unknown built-in scene '" + n +
-                              "' (table, dish_rack, open_box, binder_stack, shelf, peg_wall, peg_wall_rising, mug_tree, mug, loop_mug, ring, plate, pen, cube)");
+                              "' (table, dish_rack, open_box, binder_stack, shelf, peg_wall, peg_wall_rising, mug_tree, mug_rack, mug, loop_mug, ring, tape_roll, plate, pen, cube)");
 }
 
 std::vector<std::string> areaNames() { return {"table", "dish_rack", "open_box", "binder_stack"}; }

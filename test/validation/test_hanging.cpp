@@ -120,6 +120,30 @@ TEST(Hanging, MugHangsOnRisingPegsLeaningOnTheWall) {
       << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
 }
 
+// A wall mug rack whose board is only 12 cm tall, its pegs rising 15 degrees: the mug slides
+// to a peg's root and leans on the board's lower edge. Its shifted releases stay out of the
+// board (a release towards the wall cut to where it meets it): before, the one shifted into
+// the board touched only the board, fell, and the pose had no robust rest.
+TEST(Hanging, LowPolyMugHangsOnAWallMugRackLeaningOnItsBoard) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_lowpoly.ply");
+  const Mesh rack = scenes::mugRack();
+  PlannerConfig c = twoThreads();
+  c.placement = PlacementKind::kHanging;
+  const PlanResult r = Planner().plan(mug, rack, c);
+  ASSERT_GT(r.stableCount(), 0) << "it hangs on no peg";
+  const Candidate& best = r.candidates.front();
+  EXPECT_TRUE(best.hanging);
+  EXPECT_EQ(best.robustness.held, best.robustness.trials);
+  const Eigen::Vector3d com = best.X_WO * mug.properties.center_of_mass;
+  int on_board = 0;
+  for (const ContactPoint& p : best.contacts) on_board += p.p_W.y() > -0.002 && p.p_W.z() < com.z() + 0.003;
+  EXPECT_GT(on_board, 0) << "it does not lean on the board";
+  const PoseCheck p = PhysicsValidator(mug, rack, damped()).check(best.X_WO);
+  EXPECT_TRUE(stillHanging(p, best.X_WO, mug.properties.center_of_mass, damped()))
+      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
+}
+
 // The best candidate of `object` on the built-in mug tree with placement hanging: stable and
 // hanging; none (a failure) when nothing stable hangs there.
 std::optional<Candidate> bestHungOnTheMugTree(const Mesh& object) {

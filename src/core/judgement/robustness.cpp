@@ -32,15 +32,17 @@ Eigen::Vector2d horizontalExtent(const Rigid& X, const ObjectModel& om) {
   return hi - lo;
 }
 
+const Eigen::Vector3d kTrialDirs[4] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
+
+// `shift`: the shifted releases' offset (p.shift, or less where the area is nearer).
 Trial makeTrial(const Rigid& X, int k, const ObjectModel& om, const Eigen::Vector2d& extent,
-                const RobustnessParams& p, const Eigen::Vector3d& support) {
-  const Eigen::Vector3d dirs[4] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
-  const Eigen::Vector3d d = dirs[k % 4];
+                const RobustnessParams& p, const Eigen::Vector3d& support, double shift) {
+  const Eigen::Vector3d d = kTrialDirs[k % 4];
   Trial t{X, om.com};
   const Eigen::Vector3d com = toEigen(apply(X, om.com));
   double lift = p.lift;
   if (k < 4) {
-    t.X_start.t = t.X_start.t + toV3(p.shift * d);
+    t.X_start.t = t.X_start.t + toV3(shift * d);
     if (support.allFinite()) lift += p.shift;  // hanging: so that a loop moved across its peg clears it
   } else if (k < 8) {
     // Tilted about the horizontal axis perpendicular to d: lifted clear of what it turns into.
@@ -114,6 +116,25 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   if (kTraceTrials)
     for (size_t i = 0; i < X_GO.size(); ++i)
       std::fprintf(stderr, "pose %zu at %.3f %.3f %.3f\n", i, X_GO[i].t.x, X_GO[i].t.y, X_GO[i].t.z);
+  // A hanging pose's shifted releases stay in free space: a mug hung at a peg's root, against
+  // the wall, cannot be let go a few millimetres inside the wall. Each shift is cut to the first
+  // contact along it (V-A's translation, from the lifted release), less a millimetre.
+  std::vector<double> shift(X_GO.size() * 4, p.shift);
+  {
+    std::vector<TranslationQuery> q;
+    std::vector<size_t> at;
+    for (size_t i = 0; i < X_GO.size(); ++i)
+      if (pendulum(i))
+        for (int k = 0; k < 4; ++k) {
+          Rigid lifted = X_GO[i];
+          lifted.t = lifted.t + v3(0, 0, p.lift + p.shift);
+          q.push_back(TranslationQuery{lifted, toV3(kTrialDirs[k]), p.shift + 0.001});
+          at.push_back(i * 4 + k);
+        }
+    std::vector<double> t;
+    if (!q.empty()) ctx.backend.distance(q, t);
+    for (size_t j = 0; j < at.size(); ++j) shift[at[j]] = std::clamp(t[j] - 0.001, 0.0, p.shift);
+  }
   // In phases: the tilted releases first (the likeliest to fail: a pose they turn down needs
   // no other trial), one about x and one about y, then the other two, then the shifts and the
   // centre-of-mass offsets of the poses still open. Most poses that fail, fail the first
@@ -128,7 +149,8 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
       for (int k = 0; k < kTrials; ++k) {
         if (kPhaseOf[k] != phase) continue;
         const Eigen::Vector3d none = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-        const Trial t = makeTrial(X_GO[i], k, om, extent[i], p, i < supports.size() ? supports[i] : none);
+        const Trial t = makeTrial(X_GO[i], k, om, extent[i], p, i < supports.size() ? supports[i] : none,
+                                  shift[i * 4 + k % 4]);
         const double tmax = p.lift + std::sin(p.tilt) * om.bounding_radius + 0.05;
         stepper.addRoot(t.X_start, static_cast<int>(i) * kTrials + k, t.com_O, v3(0, 0, -1), tmax,
                         i < pegs.size() ? pegs[i] : PegLine{});
@@ -150,7 +172,8 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
         // Its centre of mass is the trial's (moved off in the centre-of-mass trials).
         const size_t pose = l.root / kTrials;
         if (!held && l.stable && pendulum(pose)) {
-          const Trial t = makeTrial(X_GO[pose], l.root % kTrials, om, extent[pose], p, supports[pose]);
+          const Trial t = makeTrial(X_GO[pose], l.root % kTrials, om, extent[pose], p, supports[pose],
+                                    shift[pose * 4 + l.root % 4]);
           // Measured from where the trial let it go: a pendulum released shifted, or with its
           // centre of mass off, re-hangs about that far from the pose (a ring spins on its peg).
           const double perturb =

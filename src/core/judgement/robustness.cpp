@@ -124,13 +124,14 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
     std::vector<TranslationQuery> q;
     std::vector<size_t> at;
     for (size_t i = 0; i < X_GO.size(); ++i)
-      if (pendulum(i))
+      if (pendulum(i)) {
+        Rigid lifted = X_GO[i];
+        lifted.t = lifted.t + v3(0, 0, p.lift + p.shift);  // as makeTrial lifts a hanging shift
         for (int k = 0; k < 4; ++k) {
-          Rigid lifted = X_GO[i];
-          lifted.t = lifted.t + v3(0, 0, p.lift + p.shift);
           q.push_back(TranslationQuery{lifted, toV3(kTrialDirs[k]), p.shift + 0.001});
           at.push_back(i * 4 + k);
         }
+      }
     std::vector<double> t;
     if (!q.empty()) ctx.backend.distance(q, t);
     for (size_t j = 0; j < at.size(); ++j) shift[at[j]] = std::clamp(t[j] - 0.001, 0.0, p.shift);

@@ -68,6 +68,9 @@ void validate(const PlannerConfig& c) {
           "robust_com_offset", c.robust_com_offset, "0 .. 0.3 (share of the object's size)");
   require(std::isfinite(c.robust_min_share) && c.robust_min_share >= 0 && c.robust_min_share <= 1,
           "robust_min_share", c.robust_min_share, "0 .. 1");
+  require(std::isfinite(c.robust_min_share_hanging) && c.robust_min_share_hanging >= 0 &&
+              c.robust_min_share_hanging <= 1,
+          "robust_min_share_hanging", c.robust_min_share_hanging, "0 .. 1");
   require(c.max_triangles >= 100 && c.max_triangles <= 50000000, "max_triangles", c.max_triangles,
           "100 .. 50000000");
   require(c.max_floor_points >= 1 && c.max_floor_points <= 1000000, "max_floor_points",

@@ -138,6 +138,7 @@ RobustnessParams robustnessParams(const PlannerConfig& config, bool scanned) {
   rp.tilt = config.robust_tilt_deg * M_PI / 180.0;
   rp.com_offset = config.robust_com_offset;
   rp.min_share = config.robust_min_share;
+  rp.min_share_hanging = config.robust_min_share_hanging;
   rp.recheck_caught = config.robust_recheck_caught;
   return rp;
 }
@@ -266,7 +267,7 @@ struct SearchMonitor {
       const std::vector<Robustness> rs = robustness(batch);
       for (size_t k = 0; k < n; ++k) {
         checked.emplace_back(batch[k], rs[k]);
-        if (rs[k].share() < config.robust_min_share - 1e-9) continue;
+        if (rs[k].share() < config.minShare(all[batch[k]].hanging) - 1e-9) continue;
         if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);
         ++stable_count;
         best_q = std::max(best_q, all[batch[k]].quality);
@@ -424,7 +425,7 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
   for (std::string& w : floor_warnings) run.result.warnings.push_back(std::move(w));
   if (!found) return std::nullopt;
   int threaded = 0;
-  for (const HangingStart& h : hangingStarts(pegs, loops, m.om, *m.backend, m.rad.cd)) {
+  for (const HangingStart& h : hangingStarts(pegs, loops, m.om, *m.backend, m.rad.cd, run.config.friction)) {
     ++threaded;
     if (gripperTiltOk(toIsometry(h.X_GO).linear(), run.config)) r.hanging.push_back(h);
   }
@@ -492,7 +493,7 @@ class TreeSearch {
     const MeshProperties& props = m_.searched(run_.object).properties;
     RankingInput in{leaves_, kinds, floor_W, m_.am->R_GW, r.R_held_G, props.bounding_radius, props.center_of_mass};
     for (const auto& [leaf, rb] : monitor_.checked)
-      if (rb.share() >= config.robust_min_share - 1e-9) in.robust_leaves.push_back(leaf);
+      if (rb.share() >= config.minShare(leaves_[leaf].hanging) - 1e-9) in.robust_leaves.push_back(leaf);
     in.cut = [this] { return run_.result.cancelled || run_.result.timed_out; };
     if (run_.run_completion() || !m_.am->open_edges.empty()) {
       // A contact on a cap of the object, away from the seen rim by more than the contact

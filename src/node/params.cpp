@@ -228,6 +228,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("robust_tilt_deg", &p.robust_tilt_deg);
   r.read("robust_com_offset", &p.robust_com_offset);
   r.read("robust_min_share", &p.robust_min_share);
+  r.read("robust_min_share_hanging", &p.robust_min_share_hanging);
   r.read("robust_check", &p.robust_check);
   r.read("robust_recheck_caught", &p.robust_recheck_caught);
   r.read("rock_settle", &p.rock_settle);

@@ -120,6 +120,7 @@ const std::map<std::string, std::string> kFlagOfField = {
     {"robust_tilt_deg", "--robust-tilt-deg"},
     {"robust_com_offset", "--robust-com-offset"},
     {"robust_min_share", "--robust-min-share"},
+    {"robust_min_share_hanging", "--robust-min-share-hanging"},
     {"time_budget_ms", "--budget-ms"},
     {"max_candidates", "--max-candidates"},
     {"threads", "--threads"},
@@ -440,6 +441,10 @@ int main(int argc, char** argv) {
       ->check(kFinite)
       ->capture_default_str();
   app.add_option("--robust-min-share", c.robust_min_share, "robustness: share of releases that must hold")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--robust-min-share-hanging", c.robust_min_share_hanging,
+                 "robustness: share of a hanging pose's releases that must hold")
       ->check(kFinite)
       ->capture_default_str();
   app.add_flag("--no-robust-check", no_robust_check, "static stability only (the paper)");

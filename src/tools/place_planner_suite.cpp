@@ -49,6 +49,7 @@ double median(std::vector<double> v) {
                "  [--holes 0.05,0.1,0.2|none] [--no-fig6] [--max-validated N] [--max-drops N]\n"
                "  [--threads N] [--friction MU] [--auto-gravity] [--orientation MODE]\n"
                "  [--robust-shift M] [--robust-tilt-deg D] [--robust-com-offset F] [--robust-min-share S]\n"
+               "  [--robust-min-share-hanging S]\n"
                "  [--no-robust-check] [--no-robust-recheck-caught] [--no-rock-settle]\n"
                "  [--scans AREA,...]  the scan suite instead: object scans on the areas' robot-head\n"
                "  scans (DATA/scans), validated on the true meshes; writes OUT/scans.{md,csv}\n"
@@ -209,6 +210,7 @@ int main(int argc, char** argv) {
     else if (a == "--robust-tilt-deg") cfg.planner.robust_tilt_deg = std::stod(next());
     else if (a == "--robust-com-offset") cfg.planner.robust_com_offset = std::stod(next());
     else if (a == "--robust-min-share") cfg.planner.robust_min_share = std::stod(next());
+    else if (a == "--robust-min-share-hanging") cfg.planner.robust_min_share_hanging = std::stod(next());
     else if (a == "--no-robust-check") cfg.planner.robust_check = false;
     else if (a == "--robust-recheck-caught") cfg.planner.robust_recheck_caught = true;
     else if (a == "--no-robust-recheck-caught") cfg.planner.robust_recheck_caught = false;

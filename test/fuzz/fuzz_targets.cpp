@@ -158,6 +158,7 @@ PlannerConfig randomConfig(Bytes& b) {
   pick(c.robust_tilt_deg, [&] { return b.range(0, 21); });
   pick(c.robust_com_offset, [&] { return b.range(0, 0.31); });
   pick(c.robust_min_share, [&] { return b.range(0, 1.01); });
+  pick(c.robust_min_share_hanging, [&] { return b.range(0, 1.01); });
   pick(c.robust_check, [&] { return b.flag(); });
   // Large values too, past validate()'s 100000 (found here: 4 * max_candidates overflowed in
   // ranking.cpp; FuzzFindings.HugeMaxCandidatesIsRefusedAndTheLimitStillFindsStablePoses).

@@ -271,7 +271,7 @@ TEST(PlacePlannerCli, HelpListsEveryOptionAndTheExitCodes) {
   EXPECT_EQ(r.code, 0);
   for (const std::string flag :
        {"--object", "--area", "--gravity", "--approach", "--friction", "--spacing", "--max-rotations", "--orientation",
-        "--max-resting-faces", "--robust-shift", "--robust-tilt-deg", "--robust-com-offset", "--robust-min-share",
+        "--max-resting-faces", "--robust-shift", "--robust-tilt-deg", "--robust-com-offset", "--robust-min-share", "--robust-min-share-hanging",
         "--no-robust-check", "--budget-ms", "--max-candidates", "--threads", "--backend", "--verify", "--json"}) {
     EXPECT_TRUE(contains(r.out, flag)) << flag;
   }

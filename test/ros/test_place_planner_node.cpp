@@ -1149,7 +1149,7 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
   for (const char* name :
        {"gravity", "approach", "friction", "floor_point_spacing", "min_floor_points", "lowest_n",
         "max_rotations", "sphere_radius", "grid_cell_size", "orientation", "max_resting_faces",
-        "robust_shift", "robust_tilt_deg", "robust_com_offset", "robust_min_share", "robust_check",
+        "robust_shift", "robust_tilt_deg", "robust_com_offset", "robust_min_share", "robust_min_share_hanging", "robust_check",
         "time_budget_s", "verify_top_k",
         "max_candidates", "threads", "max_local_optimisation_steps", "min_support_width", "min_tipping_angle_deg",
         "min_quality", "merge_distance", "merge_angle_deg", "backend", "region_min", "region_max",
@@ -1180,6 +1180,7 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
   EXPECT_EQ(y.robust_tilt_deg, d.robust_tilt_deg);
   EXPECT_EQ(y.robust_com_offset, d.robust_com_offset);
   EXPECT_EQ(y.robust_min_share, d.robust_min_share);
+  EXPECT_EQ(y.robust_min_share_hanging, d.robust_min_share_hanging);
   EXPECT_EQ(y.robust_check, d.robust_check);
   EXPECT_EQ(y.time_budget_ms, d.time_budget_ms);
   EXPECT_EQ(y.max_candidates, d.max_candidates);

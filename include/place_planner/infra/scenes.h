@@ -46,9 +46,9 @@ Mesh pegWall(double rise_deg = 0.0);
 // A mug tree: a foot 0.2 m across, a post and four arms rising 25 degrees at two heights.
 Mesh mugTree();
 // A wall mug rack: a board 0.5 m wide and only 12 cm tall (its face at y = 0) with four pegs
-// 8 mm thick and 8 cm long rising 15 degrees towards -y, each with a knob on its end. What
+// 8 mm thick and 8 cm long rising `rise_deg` towards -y, each with a knob on its end. What
 // hangs from a peg reaches below the board.
-Mesh mugRack();
+Mesh mugRack(double rise_deg = 15.0);
 // Demo objects (mesh frame at their base centre, like a scan).
 Mesh mug();           // cylinder body with a handle, 0.08 m diameter
 Mesh plate();         // flat disc 0.24 m, 2 cm thick rim

@@ -43,6 +43,7 @@ struct RobustnessParams {
   int max_rotations = 3;           // of each trial's tree
   double min_share = 1.0;          // a pose with more failed trials than this allows is decided
                                    // (its other trials stop early); the counts are then partial
+  double min_share_hanging = 1.0;  // the same for a hanging pose (its support given)
 };
 
 // Settles 12 perturbed releases of each pose with the planner's own kernels (translation to

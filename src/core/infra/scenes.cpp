@@ -191,12 +191,12 @@ Mesh mugTree() {
   return b.build("mug_tree");
 }
 
-Mesh mugRack() {
+Mesh mugRack(double rise_deg) {
   Builder b;
   b.add(box(0.5, 0.02, 0.12, {0, 0.01, 0.4}));
-  // Four pegs 8 mm thick and 8 cm long, rising 15 degrees towards -y, 12 cm apart, each with a
-  // knob on its end (a part of its own, overlapping the peg's end).
-  const double rise = 15 * M_PI / 180;
+  // Four pegs 8 mm thick and 8 cm long, rising towards -y, 12 cm apart, each with a knob on its
+  // end (a part of its own, overlapping the peg's end).
+  const double rise = rise_deg * M_PI / 180;
   const Eigen::Vector3d d(0, -std::cos(rise), std::sin(rise));
   const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), d).toRotationMatrix();
   for (const double x : {-0.18, -0.06, 0.06, 0.18}) {

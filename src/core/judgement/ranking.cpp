@@ -47,6 +47,10 @@ void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
     const bool ua = a.support != SupportKind::kSeen, ub = b.support != SupportKind::kSeen;
     if (a.stable && ua != ub) return !ua;
     if (a.preference != b.preference) return a.preference < b.preference;
+    // Among stable poses, a larger share of held releases first (a hanging pose may be stable
+    // with some releases failed: robust_min_share_hanging).
+    if (a.stable && b.stable && a.checked && b.checked && a.robustness.held * b.robustness.trials != b.robustness.held * a.robustness.trials)
+      return a.robustness.held * b.robustness.trials > b.robustness.held * a.robustness.trials;
     const long sa = quantised(a.score(), 1e-3), sb = quantised(b.score(), 1e-3);
     if (sa != sb) return sa > sb;
     const V3 pa = leaves[a.leaf].X_GO.t, pb = leaves[b.leaf].X_GO.t;
@@ -135,7 +139,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     auto record = [&](Item& it, const Robustness& r) {
       it.robustness = r;
       it.checked = r.trials > 0;
-      it.stable = it.checked && r.share() >= config.robust_min_share - 1e-9;
+      it.stable = it.checked && r.share() >= config.minShare(leaves[it.leaf].hanging) - 1e-9;
       return it.stable;
     };
     int robust = 0, checked = 0;

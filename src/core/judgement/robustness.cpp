@@ -90,10 +90,12 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   std::vector<double> tip(state.size(), kInf);
   std::vector<int> failures(X_GO.size(), 0);
   // Every trial must hold when min_share is 1: a pose's first failure ends its other trials.
-  const int allowed = static_cast<int>(std::floor((1.0 - p.min_share) * kTrials + 1e-9));
+  auto allowedFor = [](double share) { return static_cast<int>(std::floor((1.0 - share) * kTrials + 1e-9)); };
   const V3 k1_O = toV3(Eigen::Vector3d(om.principal_axes.col(0)));
   // Hanging poses (supports finite): pendulums, whose trials swing (see below).
   auto pendulum = [&](size_t i) { return i < supports.size() && supports[i].allFinite(); };
+  std::vector<int> allowed(X_GO.size());
+  for (size_t i = 0; i < X_GO.size(); ++i) allowed[i] = allowedFor(pendulum(i) ? p.min_share_hanging : p.min_share);
   // any_turn: only the centre of mass counts (a hanging pose's trials, see the hold test).
   auto near = [&](const Rigid& X, int trial, double scale, bool any_turn = false) {
     const size_t i = trial / kTrials;
@@ -146,7 +148,7 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   bool finished = true;
   for (int phase = tilted_trials ? 0 : 2; phase < 3 && finished; ++phase) {
     for (size_t i = 0; i < X_GO.size(); ++i) {
-      if (failures[i] > allowed) continue;
+      if (failures[i] > allowed[i]) continue;
       for (int k = 0; k < kTrials; ++k) {
         if (kPhaseOf[k] != phase) continue;
         const Eigen::Vector3d none = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -211,8 +213,8 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
         const size_t i = n.root / kTrials;
         // A hanging pose's trial swings (its rest turns with its centre of mass): pruned at twice
         // the distance, its turn unbounded (a ring spins).
-        if (failures[i] <= allowed && near(n.X_GO, n.root, 2.0, pendulum(i))) return false;
-        if (failures[i] <= allowed) {
+        if (failures[i] <= allowed[i] && near(n.X_GO, n.root, 2.0, pendulum(i))) return false;
+        if (failures[i] <= allowed[i]) {
           if (kTraceTrials)
             std::fprintf(stderr, "trial pose %zu k %d pruned turned %.2f\n", i, n.root % kTrials,
                          rotationAngle(n.X_GO, X_GO[i]) * 180 / M_PI);
@@ -230,7 +232,7 @@ std::vector<Robustness> check(const std::vector<Rigid>& X_GO, const TreeContext&
   std::vector<Rigid> ends;
   std::vector<int> owner;
   for (size_t r = 0; r < caught.size(); ++r)
-    if (state[r] == 1 && failures[r / kTrials] <= allowed)
+    if (state[r] == 1 && failures[r / kTrials] <= allowed[r / kTrials])
       for (const Rigid& X : caught[r]) {
         ends.push_back(X);
         owner.push_back(static_cast<int>(r));

@@ -6,14 +6,16 @@
 
 namespace place_planner {
 namespace {
-// sin(2 degrees): a peg rising more than this is hung where the object slides down to.
-constexpr double kRisingSlope = 0.035;
 // m: short of the first contact towards the base (a release a few millimetres off still clears it).
 constexpr double kBaseGap = 0.001;
 }  // namespace
 
 std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,
-                                        const ObjectModel& om, Backend& backend, double cd) {
+                                        const ObjectModel& om, Backend& backend, double cd, double friction) {
+  // A peg rising more than half the friction angle (the margin a standing pose keeps against
+  // gravity tilted that far, stability.cpp) is hung where the object slides down to; on a
+  // flatter one it stays where it is threaded.
+  const double rising_slope = std::sin(0.5 * std::atan(friction));
   std::vector<HangingStart> starts;
   std::vector<TranslationQuery> sweeps;
   const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
@@ -78,7 +80,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   std::vector<TranslationQuery> slides;
   std::vector<size_t> sliding;
   for (size_t i = 0; i < free.size(); ++i)
-    if (free[i].approach.z() < -kRisingSlope) {
+    if (free[i].approach.z() < -rising_slope) {
       sliding.push_back(i);
       slides.push_back(TranslationQuery{free[i].X_GO, toV3(free[i].approach), 0.2});
     }

@@ -128,6 +128,22 @@ TEST(Kernels, ContactCullingKeepsEveryContact) {
   EXPECT_GT(touching, 3);  // the poses do touch the rack
 }
 
+// The area's own normal at a contact weighs each face by how squarely it faces the object's
+// surface: a mug's side (facing +y) touching a board's lower edge is pushed by the board's face
+// (-y), not held up by its underside, which is at right angles to the side and, turned towards
+// the centre of mass above it, would point up and read as a floor.
+TEST(Kernels, AnObjectsSideOnABoardsLowerEdgeMeetsTheBoardsFace) {
+  const AreaModel am = buildAreaModel(scenes::mugRack(), {0, 0, -1}, 0.00225, 0.00375, 0.00375);
+  const AreaView a = view(am);
+  // The board's face is y = 0, its lower edge z = 0.34 (the nearest peg 1 cm away in x, 6 cm
+  // up); the side reaches 2 mm under the board, where the underside's spheres are in reach.
+  const V3 s = v3(0.05, 0.002, 0.34), n_side = v3(0, 1, 0), com = v3(0.05, -0.04, 0.36);
+  const SphereContact c = sphereContact(a, s, n_side, com);
+  ASSERT_TRUE(c.valid);
+  EXPECT_LT(c.na.y, -0.9);
+  EXPECT_LT(std::abs(c.na.z), 0.3) << "the area's normal there leans " << c.na.z << " up: a floor, not a wall";
+}
+
 // A wall's normal keeps its side where the object faces it, wherever the centre of mass lies:
 // a ring round a post 24 mm thick has its centre of mass inside the post, and the post pushes
 // the ring out (sphereContact turns other normals towards the centre of mass). Above the

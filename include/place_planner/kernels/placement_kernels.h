@@ -346,6 +346,9 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
 // An area normal and the object's inward normal agree when their cosine exceeds this (surfaces
 // facing each other within about 72 degrees).
 constexpr double kAgree = 0.3;
+// The least weight of an area face in the area's own normal at a contact (sphereContact), for
+// one at right angles to the object's surface there.
+constexpr double kEdgeWeight = 0.05;
 
 struct SphereContact {
   V3 p;       // p_c: mean of the colliding area spheres
@@ -373,7 +376,7 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   // Early out: above every height in this cell from which a contact can be made.
   if (s_G.z > g.max_contact_z[cell]) return out;
   const double cd2 = g.collision_distance * g.collision_distance;
-  V3 sum = v3(0, 0, 0), nsum = v3(0, 0, 0);
+  V3 sum = v3(0, 0, 0), nsum = v3(0, 0, 0), nfacing = v3(0, 0, 0);
   int count = 0;
   double gap = kInf;
   const double lateral2 = 2.25 * area.mesh.sphere_radius * area.mesh.sphere_radius;
@@ -398,6 +401,10 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
     if (!faces && dot(na, com_G - a) < 0) na = -na;
     sum = sum + a;
     nsum = nsum + na;
+    // The area's own normal weighs each face by how squarely it faces the object's surface:
+    // where a mug's side meets a board's lower edge, the board's underside (at right angles to
+    // the side) does not push; the board's face does, sideways (a wall, not a floor).
+    nfacing = nfacing + (fabs(dot(na, n_G)) + kEdgeWeight) * na;
     ++count;
     // Separation along the area's normal: zero for touching surfaces, whatever the lateral
     // offset of the two sphere lattices. Only where the object sphere lies over this sphere's
@@ -417,7 +424,7 @@ PP_HD SphereContact sphereContact(const AreaView& area, V3 s_G, V3 n_G, V3 com_G
   const bool agree = (com_G.z < out.p.z || fabs(nmean.z) < kAgree * nm) && dot(nmean, no) > kAgree * nm;
   if (!agree && dot(no, com_G - s_G) < 0) no = -no;
   V3 n = nmean + no;
-  if (norm2(nmean) > 1e-12) out.na = normalized(nmean);
+  if (norm2(nfacing) > 1e-12) out.na = normalized(nfacing);
   if (norm2(n) < 1e-12) n = s_G - out.p;
   if (!agree && dot(n, com_G - out.p) < 0) n = -n;
   out.n = normalized(n);

@@ -120,86 +120,13 @@ TEST(Hanging, MugHangsOnRisingPegsLeaningOnTheWall) {
       << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
 }
 
-// A wall mug rack whose board is only 12 cm tall, its pegs rising 15 degrees: the mug slides
-// to a peg's root and leans on the board's lower edge. Its shifted releases stay out of the
-// board (a release towards the wall cut to where it meets it): before, the one shifted into
-// the board touched only the board, fell, and the pose had no robust rest.
-TEST(Hanging, LowPolyMugHangsOnAWallMugRackLeaningOnItsBoard) {
-  PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_lowpoly.ply");
-  const Mesh rack = scenes::mugRack();
+// The best candidate of `object` on `area` with placement hanging: stable and hanging; none (a
+// failure) when nothing stable hangs there.
+std::optional<Candidate> bestHung(const Mesh& object, const Mesh& area) {
   PlannerConfig c = twoThreads();
   c.placement = PlacementKind::kHanging;
-  const PlanResult r = Planner().plan(mug, rack, c);
-  ASSERT_GT(r.stableCount(), 0) << "it hangs on no peg";
-  const Candidate& best = r.candidates.front();
-  EXPECT_TRUE(best.hanging);
-  EXPECT_EQ(best.robustness.held, best.robustness.trials);
-  const Eigen::Vector3d com = best.X_WO * mug.properties.center_of_mass;
-  int on_board = 0;
-  for (const ContactPoint& p : best.contacts) on_board += p.p_W.y() > -0.002 && p.p_W.z() < com.z() + 0.003;
-  EXPECT_GT(on_board, 0) << "it does not lean on the board";
-  const PoseCheck p = PhysicsValidator(mug, rack, damped()).check(best.X_WO);
-  EXPECT_TRUE(stillHanging(p, best.X_WO, mug.properties.center_of_mass, damped()))
-      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
-}
-
-// The same rack with its pegs rising 5 degrees, under half the friction angle: the mug stays
-// where it is threaded, clear of the board, and hangs there. Before, every peg rising more
-// than 2 degrees slid it down to the board's lower edge, where the YCB mug found no rest.
-TEST(Hanging, MugStaysWhereThreadedOnAPegRisingUnderHalfTheFrictionAngle) {
-  PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
-  const Mesh rack = scenes::mugRack(5.0);
-  PlannerConfig c = twoThreads();
-  c.placement = PlacementKind::kHanging;
-  const PlanResult r = Planner().plan(mug, rack, c);
-  ASSERT_GT(r.stableCount(), 0) << "it hangs on no peg";
-  const Candidate& best = r.candidates.front();
-  EXPECT_TRUE(best.hanging);
-  const Eigen::Vector3d com = best.X_WO * mug.properties.center_of_mass;
-  for (const ContactPoint& p : best.contacts) {
-    EXPECT_GT(p.p_W.z(), com.z() + 0.01) << "a contact below the centre of mass (the board?)";
-    EXPECT_LT(p.p_W.y(), -0.01) << "a contact at the board";
-  }
-  const PoseCheck p = PhysicsValidator(mug, rack, damped()).check(best.X_WO);
-  EXPECT_TRUE(stillHanging(p, best.X_WO, mug.properties.center_of_mass, damped()))
-      << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
-}
-
-// A hanging pose is stable when robust_min_share_hanging (0.75) of its perturbed releases hold:
-// the flat-bar mug on the mug tree has one pose whose every release holds, and with the
-// default share more, each of the three best kept hanging by Bullet.
-TEST(Hanging, MostReleasesHoldingIsEnoughForAHangingPoseAndBulletAgrees) {
-  const Mesh mug = scenes::byName("loop_mug");
-  const Mesh tree = scenes::mugTree();
-  PlannerConfig all = twoThreads();
-  all.placement = PlacementKind::kHanging;
-  all.robust_min_share_hanging = 1.0;
-  const PlanResult strict = Planner().plan(mug, tree, all);
-  PlannerConfig c = twoThreads();
-  c.placement = PlacementKind::kHanging;
-  const PlanResult r = Planner().plan(mug, tree, c);
-  EXPECT_LE(strict.stableCount(), 1);
-  ASSERT_GE(r.stableCount(), 3);
-  for (int i = 0; i < 3; ++i) {
-    const Candidate& k = r.candidates[i];
-    EXPECT_TRUE(k.stable && k.hanging);
-    EXPECT_GE(k.robustness.share(), 0.75);
-    if (i > 0) EXPECT_LE(k.robustness.share(), r.candidates[i - 1].robustness.share()) << "not ranked by share";
-    const PoseCheck p = PhysicsValidator(mug, tree, damped()).check(k.X_WO);
-    EXPECT_TRUE(stillHanging(p, k.X_WO, mug.properties.center_of_mass, damped()))
-        << "candidate " << i << ": Bullet moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
-  }
-}
-
-// The best candidate of `object` on the built-in mug tree with placement hanging: stable and
-// hanging; none (a failure) when nothing stable hangs there.
-std::optional<Candidate> bestHungOnTheMugTree(const Mesh& object) {
-  PlannerConfig c = twoThreads();
-  c.placement = PlacementKind::kHanging;
-  const PlanResult r = Planner().plan(object, scenes::mugTree(), c);
-  EXPECT_GT(r.stableCount(), 0) << "it hangs on no arm";
+  const PlanResult r = Planner().plan(object, area, c);
+  EXPECT_GT(r.stableCount(), 0) << "it hangs nowhere";
   if (r.stableCount() == 0 || !r.candidates.front().stable) return std::nullopt;
   EXPECT_TRUE(r.candidates.front().hanging);
   return r.candidates.front();
@@ -225,13 +152,72 @@ void expectStillHangsInBullet(const Mesh& object, const Mesh& area, const Candid
       << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
 }
 
+// A wall mug rack whose board is only 12 cm tall, its pegs rising 15 degrees: the mug slides
+// to a peg's root and leans on the board's lower edge. Its shifted releases stay out of the
+// board (a release towards the wall cut to where it meets it): before, the one shifted into
+// the board touched only the board, fell, and the pose had no robust rest.
+TEST(Hanging, LowPolyMugHangsOnAWallMugRackLeaningOnItsBoard) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_lowpoly.ply");
+  const Mesh rack = scenes::mugRack();
+  const std::optional<Candidate> best = bestHung(mug, rack);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->robustness.held, best->robustness.trials);
+  const Eigen::Vector3d com = best->X_WO * mug.properties.center_of_mass;
+  int on_board = 0;
+  for (const ContactPoint& p : best->contacts) on_board += p.p_W.y() > -0.002 && p.p_W.z() < com.z() + 0.003;
+  EXPECT_GT(on_board, 0) << "it does not lean on the board";
+  expectStillHangsInBullet(mug, rack, *best);
+}
+
+// The same rack with its pegs rising 5 degrees, under half the friction angle: the mug stays
+// where it is threaded, clear of the board, and hangs there. Before, every peg rising more
+// than 2 degrees slid it down to the board's lower edge, where the YCB mug found no rest.
+TEST(Hanging, MugStaysWhereThreadedOnAPegRisingUnderHalfTheFrictionAngle) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh rack = scenes::mugRack(5.0);
+  const std::optional<Candidate> best = bestHung(mug, rack);
+  ASSERT_TRUE(best);
+  const Eigen::Vector3d com = best->X_WO * mug.properties.center_of_mass;
+  for (const ContactPoint& p : best->contacts) {
+    EXPECT_GT(p.p_W.z(), com.z() + 0.01) << "a contact below the centre of mass (the board?)";
+    EXPECT_LT(p.p_W.y(), -0.01) << "a contact at the board";
+  }
+  expectStillHangsInBullet(mug, rack, *best);
+}
+
+// A hanging pose is stable when robust_min_share_hanging (0.75) of its perturbed releases hold:
+// the flat-bar mug on the mug tree has one pose whose every release holds, and with the
+// default share more, each of the three best kept hanging by Bullet.
+TEST(Hanging, MostReleasesHoldingIsEnoughForAHangingPoseAndBulletAgrees) {
+  const Mesh mug = scenes::byName("loop_mug");
+  const Mesh tree = scenes::mugTree();
+  PlannerConfig all = twoThreads();
+  all.placement = PlacementKind::kHanging;
+  all.robust_min_share_hanging = 1.0;
+  const PlanResult strict = Planner().plan(mug, tree, all);
+  PlannerConfig c = twoThreads();
+  c.placement = PlacementKind::kHanging;
+  const PlanResult r = Planner().plan(mug, tree, c);
+  EXPECT_LE(strict.stableCount(), 1);
+  ASSERT_GE(r.stableCount(), 3);
+  for (int i = 0; i < 3; ++i) {
+    const Candidate& k = r.candidates[i];
+    EXPECT_TRUE(k.stable && k.hanging);
+    EXPECT_GE(k.robustness.share(), 0.75);
+    if (i > 0) EXPECT_LE(k.robustness.share(), r.candidates[i - 1].robustness.share()) << "not ranked by share";
+    expectStillHangsInBullet(mug, tree, k);
+  }
+}
+
 // A mug tree's arms rise 25 degrees, past the friction angle (atan 0.2 = 11.3): hung on an arm,
 // the mug slides down it to the post. It is threaded on until it meets the post and hangs there,
 // its body leaning on the post below the arm; Bullet keeps it hanging.
 TEST(Hanging, MugHangsAtTheRootOfAMugTreesRisingArm) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
-  const std::optional<Candidate> best = bestHungOnTheMugTree(mug);
+  const std::optional<Candidate> best = bestHung(mug, scenes::mugTree());
   ASSERT_TRUE(best);
   EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
   // Held from above by an arm, within its first 3 cm from the post (radius 12 mm), where it
@@ -245,7 +231,7 @@ TEST(Hanging, MugHangsAtTheRootOfAMugTreesRisingArm) {
 // swing on the arm as the pose's did (without the peg they slid and failed: no robust pose).
 TEST(Hanging, RingLeansOnTheMugTreesPostAndStaysOnItsArm) {
   const Mesh ring = scenes::byName("ring");
-  const std::optional<Candidate> best = bestHungOnTheMugTree(ring);
+  const std::optional<Candidate> best = bestHung(ring, scenes::mugTree());
   ASSERT_TRUE(best);
   EXPECT_EQ(best->robustness.held, best->robustness.trials);
   // Held from above by an arm (its root 1.2 cm from the post's axis, its tip 9 cm out).

@@ -52,10 +52,12 @@ struct PlannerConfig {
   double robust_com_offset = 0.05;           // centre of mass off by this share of the object's extent along x, y
   double robust_min_share = 1.0;             // share of perturbed releases that must hold
   // The same for a hanging pose: a pendulum's releases swing into the wall or board below its
-  // peg, which the swing settles only roughly (doc/validation.md, Hanging); a larger share
-  // still ranks first (the score's share term).
+  // peg, which the swing settles only roughly (doc/validation.md, Hanging); among stable poses
+  // a larger share ranks first (ranking.h).
   double robust_min_share_hanging = 0.75;
   double minShare(bool hanging) const { return hanging ? robust_min_share_hanging : robust_min_share; }
+  // A pose whose share of held releases is `share` is robust (hanging or standing).
+  bool robustShare(double share, bool hanging) const { return share >= minShare(hanging) - 1e-9; }
   bool robust_check = true;                  // false: static stability only (the paper)
   // Tilted releases caught where they land (3.5 deg off, stable, tipping margin >= 20 deg) also
   // hold when that pose holds its own shift and centre-of-mass trials: poses on domed supports

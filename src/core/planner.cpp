@@ -267,7 +267,7 @@ struct SearchMonitor {
       const std::vector<Robustness> rs = robustness(batch);
       for (size_t k = 0; k < n; ++k) {
         checked.emplace_back(batch[k], rs[k]);
-        if (rs[k].share() < config.minShare(all[batch[k]].hanging) - 1e-9) continue;
+        if (!config.robustShare(rs[k].share(), all[batch[k]].hanging)) continue;
         if (st.first_stable_ms < 0) st.first_stable_ms = msSince(t0);
         ++stable_count;
         best_q = std::max(best_q, all[batch[k]].quality);
@@ -493,7 +493,7 @@ class TreeSearch {
     const MeshProperties& props = m_.searched(run_.object).properties;
     RankingInput in{leaves_, kinds, floor_W, m_.am->R_GW, r.R_held_G, props.bounding_radius, props.center_of_mass};
     for (const auto& [leaf, rb] : monitor_.checked)
-      if (rb.share() >= config.minShare(leaves_[leaf].hanging) - 1e-9) in.robust_leaves.push_back(leaf);
+      if (config.robustShare(rb.share(), leaves_[leaf].hanging)) in.robust_leaves.push_back(leaf);
     in.cut = [this] { return run_.result.cancelled || run_.result.timed_out; };
     if (run_.run_completion() || !m_.am->open_edges.empty()) {
       // A contact on a cap of the object, away from the seen rim by more than the contact

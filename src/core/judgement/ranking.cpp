@@ -49,8 +49,10 @@ void sortItems(std::vector<Item>& items, const std::vector<TreeLeaf>& leaves) {
     if (a.preference != b.preference) return a.preference < b.preference;
     // Among stable poses, a larger share of held releases first (a hanging pose may be stable
     // with some releases failed: robust_min_share_hanging).
-    if (a.stable && b.stable && a.checked && b.checked && a.robustness.held * b.robustness.trials != b.robustness.held * a.robustness.trials)
-      return a.robustness.held * b.robustness.trials > b.robustness.held * a.robustness.trials;
+    if (a.stable && b.stable && a.checked && b.checked) {
+      const long ha = quantised(a.robustness.share(), 1e-6), hb = quantised(b.robustness.share(), 1e-6);
+      if (ha != hb) return ha > hb;
+    }
     const long sa = quantised(a.score(), 1e-3), sb = quantised(b.score(), 1e-3);
     if (sa != sb) return sa > sb;
     const V3 pa = leaves[a.leaf].X_GO.t, pb = leaves[b.leaf].X_GO.t;
@@ -139,7 +141,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     auto record = [&](Item& it, const Robustness& r) {
       it.robustness = r;
       it.checked = r.trials > 0;
-      it.stable = it.checked && r.share() >= config.minShare(leaves[it.leaf].hanging) - 1e-9;
+      it.stable = it.checked && config.robustShare(r.share(), leaves[it.leaf].hanging);
       return it.stable;
     };
     int robust = 0, checked = 0;

@@ -187,6 +187,24 @@ TEST(Hanging, MugStaysWhereThreadedOnAPegRisingUnderHalfTheFrictionAngle) {
   expectStillHangsInBullet(mug, rack, *best);
 }
 
+// A roll of tape (11 cm across, 4.8 cm deep) on the mug tree's arms, 9 cm long and rising 25
+// degrees: threaded to the middle of an arm, its rim, tilted with the arm, meets the post; it
+// threads on to the arm's far end instead, slides down to the post and hangs there, held from
+// above on the arm. Before, nothing threaded it (no start: no stable pose).
+TEST(Hanging, ARollOfTapeThreadsPastTheMugTreesPostAndHangs) {
+  const Mesh tape = scenes::byName("tape_roll");
+  const Mesh tree = scenes::mugTree();
+  const std::optional<Candidate> best = bestHung(tape, tree);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
+  // The arms reach 10 cm from the post's axis; the tape's 5.5 cm rim stays clear of the post
+  // (1.2 cm) and of the foot (2 cm high).
+  expectHeldFromAboveWithin(tape, *best, 0.10);
+  const Eigen::Vector3d com = best->X_WO * tape.properties.center_of_mass;
+  EXPECT_GT(com.head<2>().norm(), 0.03) << "its centre of mass inside the post";
+  expectStillHangsInBullet(tape, tree, *best);
+}
+
 // A hanging pose is stable when robust_min_share_hanging (0.75) of its perturbed releases hold:
 // the flat-bar mug on the mug tree has one pose whose every release holds, and with the
 // default share more, each of the three best kept hanging by Bullet.

@@ -18,6 +18,8 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   const double rising_slope = std::sin(0.5 * std::atan(friction));
   std::vector<HangingStart> starts;
   std::vector<TranslationQuery> sweeps;
+  std::vector<int> group;  // per start: its peg, loop and way round
+  int groups = 0;
   const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d com_O = toEigen(om.com);
   for (const Peg& peg : pegs)
@@ -50,21 +52,29 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         const double nearest = back + cd + 0.001,
                      farthest = length - 0.5 * loop.thickness - std::min(0.5 * loop.thickness, 0.01);
         if (nearest > farthest) continue;
-        const double along = 0.5 * (nearest + farthest);
-        const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis;
-        Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-        X.linear() = R;
-        X.translation() = at - R * loop.centre;
-        HangingStart h;
-        h.X_GO = toRigid(X);
-        h.drop = 2 * om.bounding_radius;  // its first contact ends it (V-A), below the opening's top
-        h.approach = -peg.axis;
-        h.approach_distance = (length - along) + back + 0.01;
-        h.peg_point = at;
-        Eigen::Isometry3d pre = X;
-        pre.translation() += h.approach_distance * peg.axis;
-        sweeps.push_back(TranslationQuery{toRigid(pre), toV3(h.approach), h.approach_distance + 0.01});
-        starts.push_back(h);
+        // Threaded to the middle of that room or, where the sweep finds the middle blocked (a
+        // wide loop on a steep arm meets the post behind it), to its far end: on a rising peg it
+        // then slides to where it rests either way (below).
+        for (const double along : {0.5 * (nearest + farthest), farthest}) {
+          const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis;
+          Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+          X.linear() = R;
+          X.translation() = at - R * loop.centre;
+          HangingStart h;
+          h.X_GO = toRigid(X);
+          h.drop =
+              2 * om.bounding_radius;  // its first contact ends it (V-A), below the opening's top
+          h.approach = -peg.axis;
+          h.approach_distance = (length - along) + back + 0.01;
+          h.peg_point = at;
+          Eigen::Isometry3d pre = X;
+          pre.translation() += h.approach_distance * peg.axis;
+          sweeps.push_back(
+              TranslationQuery{toRigid(pre), toV3(h.approach), h.approach_distance + 0.01});
+          starts.push_back(h);
+          group.push_back(groups);
+        }
+        ++groups;
       }
     }
   if (starts.empty()) return starts;
@@ -72,8 +82,12 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   std::vector<double> t;
   backend.distance(sweeps, t);
   std::vector<HangingStart> free;
+  std::vector<char> threaded(groups, 0);  // one start per peg, loop and way round: the first free
   for (size_t i = 0; i < starts.size(); ++i)
-    if (t[i] >= starts[i].approach_distance + 1e-3) free.push_back(starts[i]);
+    if (!threaded[group[i]] && t[i] >= starts[i].approach_distance + 1e-3) {
+      threaded[group[i]] = 1;
+      free.push_back(starts[i]);
+    }
   // On a peg rising towards its tip the object would slide back down it: it is threaded on
   // until its first contact towards the base (V-A's translation along the peg: the wall, a
   // post, what hangs below meeting them first), kBaseGap short of it, and hangs there.

@@ -52,8 +52,8 @@ struct PlannerConfig {
   double robust_com_offset = 0.05;           // centre of mass off by this share of the object's extent along x, y
   double robust_min_share = 1.0;             // share of perturbed releases that must hold
   // The same for a hanging pose: a pendulum's releases swing into the wall or board below its
-  // peg, which the swing settles only roughly (doc/validation.md, Hanging); among stable poses
-  // a larger share ranks first (ranking.h).
+  // peg, which the swing settles only roughly (doc/validation.md, Hanging); each failed
+  // release lowers the pose's score (ranking.h).
   double robust_min_share_hanging = 0.75;
   double minShare(bool hanging) const { return hanging ? robust_min_share_hanging : robust_min_share; }
   // A pose whose share of held releases is `share` is robust (hanging or standing).

@@ -62,8 +62,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
           X.translation() = at - R * loop.centre;
           HangingStart h;
           h.X_GO = toRigid(X);
-          h.drop =
-              2 * om.bounding_radius;  // its first contact ends it (V-A), below the opening's top
+          h.drop = 2 * om.bounding_radius;  // its first contact ends it (V-A), below the opening's top
           h.approach = -peg.axis;
           h.approach_distance = (length - along) + back + 0.01;
           h.peg_point = at;

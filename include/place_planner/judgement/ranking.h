@@ -35,9 +35,10 @@ using PlacementCheck = std::function<Placement(size_t)>;
 
 // Ranks stable before not stable, then by config.rank_order (kLowest: centre of mass height in
 // 5 mm steps; kNearest: distance to prefer_near in 5 mm steps), then by the score
-//   Q - 0.05 * reorientation / pi - (1 - robust share) + 0.25 * mean push resistance
+//   Q - 0.05 * reorientation / pi - w * (1 - robust share) + 0.25 * mean push resistance
 // (re-orientation: the angle from the held orientation, a secondary key: a half turn costs as
-// much as 0.05 of Q; a failed release of 12 costs 0.083, ranking.cpp). It merges poses within
+// much as 0.05 of Q; w = 1 for a stable pose, where a failed release of 12 costs 0.083, and
+// 0.05 for one that is not, ranking.cpp). It merges poses within
 // merge_distance and merge_angle_deg of a better one, drops Q < min_quality, and checks
 // robustness lazily (config.robust_check): a stable leaf whose share of held trials is below
 // robust_min_share (robust_min_share_hanging for a hanging one) is returned as not stable. With a grasp, leaves pointing the gripper over max_gripper_tilt_deg

@@ -22,8 +22,10 @@ constexpr double kPushWeight = 0.25;
 // 0.083, about what separates a pose hanging free from one propped on the wall (Q). Measured on
 // the hanging suite (scripts/bench --hanging): 0.5: 27/32 best, top-3 75/80; 1: 27/32, 77/80;
 // 2: 27/32, 76/80; a larger share always first: 26/32, 76/80. Standing poses are stable only
-// with every release held (robust_min_share 1), so for them it changes nothing.
+// with every release held (robust_min_share 1), so for them it changes nothing. Among poses
+// that are not stable the share is a tie-break (kUnstableShareWeight): they rank by Q.
 constexpr double kShareWeight = 1.0;
+constexpr double kUnstableShareWeight = 0.05;
 
 struct Item {
   size_t leaf;
@@ -38,7 +40,8 @@ struct Item {
   bool pushed = false;  // push computed
   double score() const {
     const double share = checked ? robustness.share() : 1.0;
-    return quality - 0.05 * reorientation / M_PI - kShareWeight * (1.0 - share) + kPushWeight * push.mean;
+    const double w = stable ? kShareWeight : kUnstableShareWeight;
+    return quality - 0.05 * reorientation / M_PI - w * (1.0 - share) + kPushWeight * push.mean;
   }
 };
 

@@ -18,7 +18,8 @@ struct RankingInput {
   Eigen::Matrix3d R_held_G;   // the held orientation, for the re-orientation key
   double object_radius = 0;   // m, bounding radius (contact summaries)
   Eigen::Vector3d com_O = Eigen::Vector3d::Zero();  // object's centre of mass (kLowest)
-  std::vector<size_t> robust_leaves = {};  // leaves the search already found robust (kept when merging)
+  // Leaves the search already found robust (kept when merging).
+  std::vector<size_t> robust_leaves = {};
   // True once a cancel or the budget has cut the plan: the robust leaves above stay robust even
   // where the ranking's own checks did not reach them.
   std::function<bool()> cut = {};
@@ -38,12 +39,13 @@ using PlacementCheck = std::function<Placement(size_t)>;
 //   Q - 0.05 * reorientation / pi - w * (1 - robust share) + 0.25 * mean push resistance
 // (re-orientation: the angle from the held orientation, a secondary key: a half turn costs as
 // much as 0.05 of Q; w = 1 for a stable pose, where a failed release of 12 costs 0.083, and
-// 0.05 for one that is not, ranking.cpp). It merges poses within
-// merge_distance and merge_angle_deg of a better one, drops Q < min_quality, and checks
-// robustness lazily (config.robust_check): a stable leaf whose share of held trials is below
-// robust_min_share (robust_min_share_hanging for a hanging one) is returned as not stable. With a grasp, leaves pointing the gripper over max_gripper_tilt_deg
-// are dropped; a candidate that `place` finds blocked is dropped (kept, not stable, with the
-// reason when keep_colliding) and the next one checked in its stead.
+// 0.05 for one that is not, ranking.cpp). It merges poses within merge_distance and
+// merge_angle_deg of a better one, drops Q < min_quality, and checks robustness lazily
+// (config.robust_check): a stable leaf whose share of held trials is below robust_min_share
+// (robust_min_share_hanging for a hanging one) is returned as not stable. With a grasp, leaves
+// pointing the gripper over max_gripper_tilt_deg are dropped; a candidate that `place` finds
+// blocked is dropped (kept, not stable, with the reason when keep_colliding) and the next one
+// checked in its stead.
 std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfig& config,
                                       const RobustnessCheck& check, PlanStats* stats,
                                       const PlacementCheck& place = {});

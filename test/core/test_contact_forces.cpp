@@ -206,6 +206,35 @@ TEST(ContactForces, LineOfContactsHoldsOnlyWithTheCentreOfMassOnIt) {
   EXPECT_FALSE(evaluateStability(line, Eigen::Vector3d(0, 0, 0.02), StabilityParams{}).stable);
 }
 
+// The settle of an unbalanced pose (ContactForces::unbalanced): it never drives a contact into
+// its surface, gravity does work along it, and it is zero where gravity is balanced.
+TEST(ContactForces, UnbalancedWrenchStartsASettleThatPushesNoContactIn) {
+  // A box on a floor point and against a wall (x = 0, normal -x), its centre of mass beyond
+  // the floor point away from the wall: it tips away from the wall.
+  std::vector<ContactPoint> c = {{{-0.02, 0, 0}, {0, 0, 1}}, {{0, 0, 0.03}, {-1, 0, 0}}};
+  const Eigen::Vector3d com(-0.03, 0, 0.02);
+  const ContactForces f(c, com, ForceModelParams{0.2, 8, 3.0});
+  ASSERT_FALSE(f.balances(kGravity));
+  Eigen::Vector3d v, w;
+  f.unbalanced(kGravity, &v, &w);
+  ASSERT_GT(v.norm() + w.norm(), 1e-6);
+  EXPECT_LT(v.z(), 0) << "the centre of mass does not sink";
+  for (const ContactPoint& p : c) {
+    const Eigen::Vector3d vel = v + w.cross(p.p_W - com);
+    EXPECT_GE(vel.dot(p.n_W), -1e-6) << "the settle pushes a contact into its surface";
+  }
+  // It tips about its floor point away from the wall: a turn about -y lowers the centre of
+  // mass, which lies beyond the floor point on -x.
+  EXPECT_LT(w.y(), 0);
+  // The same box with its centre of mass over its floor point, leaning nowhere: balanced.
+  const ContactForces g({{{-0.02, -0.01, 0}, {0, 0, 1}}, {{-0.02, 0.01, 0}, {0, 0, 1}},
+                         {{0, 0, 0.03}, {-1, 0, 0}}, {{-0.04, 0, 0}, {0, 0, 1}}},
+                        Eigen::Vector3d(-0.025, 0, 0.02), ForceModelParams{0.2, 8, 3.0});
+  ASSERT_TRUE(g.balances(kGravity));
+  g.unbalanced(kGravity, &v, &w);
+  EXPECT_EQ(v.norm() + w.norm(), 0.0);
+}
+
 TEST(ContactForces, CubeSlidesOnASlopeSteeperThanTheFrictionAngle) {
   // The planar case's closed form (slope < atan mu) and the force model agree.
   const double mu = 0.4;

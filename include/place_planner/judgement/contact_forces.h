@@ -42,6 +42,13 @@ class ContactForces {
   // the contacts resist together with gravity: balances(-z + alpha d), by bisection to cap / 2^7.
   // 0 when gravity alone is not balanced.
   double pushResistance(const Eigen::Vector3d& d, double cap = 1.0) const;
+  // Where gravity (f_ext) is not balanced: the net wrench that is left when the contacts push
+  // as well as they can (the NNLS residual), as the rigid motion it starts, frame G: a
+  // translation direction v (weights) and a rotation w (rad per metre of v: a point at the
+  // contacts' reach moves |w| reach). It never pushes a contact into its surface (the NNLS
+  // optimality: every cone edge's velocity is >= 0) and gravity does work along it (the
+  // centre of mass sinks), so it is the first-order settle. Zero when balanced.
+  void unbalanced(const Eigen::Vector3d& f_ext, Eigen::Vector3d* v, Eigen::Vector3d* w) const;
   bool empty() const { return A_.cols() == 0; }
   // The force on contact i (G, weights) of the cone-edge weights `forces` (balances()).
   Eigen::Vector3d contactForce(const Eigen::VectorXd& forces, size_t i) const;
@@ -49,6 +56,7 @@ class ContactForces {
  private:
   Eigen::Matrix<double, 7, Eigen::Dynamic> A_;  // rows: force (3), torque / L (3), load weight (1)
   double max_load_;
+  double reach_ = 1e-3;  // m: torques are divided by it (A_'s rows 3-5)
   int edges_ = 8;
 };
 

@@ -36,6 +36,10 @@ struct Stability {
   // its handle). Stable when the forces balance gravity and friction holds gravity tilted by
   // half the friction angle; a tilt's torque is taken by a swing (the tree's swing settle).
   bool hanging = false;
+  // Hanging and not balanced: the rigid motion the unbalanced wrench starts
+  // (ContactForces::unbalanced; the swing's settle move), translation v and rotation w about
+  // the centre of mass, scaled so that a point at the contacts' reach moves 1 (|v| + |w| reach).
+  Eigen::Vector3d settle_v = Eigen::Vector3d::Zero(), settle_w = Eigen::Vector3d::Zero();
   Eigen::Vector3d d_f = Eigen::Vector3d::Zero();    // failure direction (unit)
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  // farthest contact of Omega along d_f
   // Tipping: the edge of Omega that the centre of mass lies beyond (or is nearest to), as a

@@ -53,6 +53,8 @@ struct TreeNode {
   int swings = 0;
   bool swung = false;
   int swing_pose = -1;  // index in `path` of the swing's last pose (-1: none)
+  // Its last stability test's settle (Stability::settle_v, settle_w): zero when balanced.
+  Eigen::Vector3d settle_v = Eigen::Vector3d::Zero(), settle_w = Eigen::Vector3d::Zero();
   // The peg it was threaded on, if any. The swing turns the loop round the peg and slides it
   // across, never along it: along it friction decides.
   PegLine peg;

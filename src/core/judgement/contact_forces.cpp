@@ -102,6 +102,7 @@ ContactForces::ContactForces(const std::vector<ContactPoint>& contacts, const Ei
   // Torques in units of force: divided by the contacts' reach from the centre of mass.
   double L = 1e-3;
   for (const ContactPoint& c : contacts) L = std::max(L, (c.p_W - com).norm());
+  reach_ = L;
   A_.resize(7, edges * static_cast<long>(contacts.size()));
   for (size_t i = 0; i < contacts.size(); ++i) {
     const Eigen::Vector3d n = contacts[i].n_W.normalized();
@@ -129,6 +130,18 @@ bool ContactForces::balances(const Eigen::Vector3d& f_ext, Eigen::VectorXd* forc
   const double residual = (A_.topRows(6) * x - b.head<6>()).norm();
   const double load = A_.row(6).dot(x) / kLoadWeight;  // total normal force
   return residual < 1e-4 * f_ext.norm() && load <= max_load_ * f_ext.norm();
+}
+
+void ContactForces::unbalanced(const Eigen::Vector3d& f_ext, Eigen::Vector3d* v, Eigen::Vector3d* w) const {
+  Eigen::Matrix<double, 7, 1> b = Eigen::Matrix<double, 7, 1>::Zero();
+  b.head<3>() = -f_ext;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(A_.cols());
+  if (A_.cols() > 0) nnlsRows<7>(A_, b, &x);
+  // The net wrench on the object: the contact forces plus f_ext (torque rows over reach_).
+  const Eigen::Matrix<double, 6, 1> r = A_.topRows(6) * x - b.head<6>();
+  const bool balanced = r.norm() < 1e-4 * f_ext.norm();
+  *v = balanced ? Eigen::Vector3d::Zero() : Eigen::Vector3d(r.head<3>());
+  *w = balanced ? Eigen::Vector3d::Zero() : Eigen::Vector3d(r.tail<3>() / reach_);
 }
 
 Eigen::Vector3d ContactForces::contactForce(const Eigen::VectorXd& forces, size_t i) const {

@@ -26,6 +26,8 @@ constexpr double kPushWeight = 0.25;
 // that are not stable the share is a tie-break (kUnstableShareWeight): they rank by Q.
 constexpr double kShareWeight = 1.0;
 constexpr double kUnstableShareWeight = 0.05;
+// Intermediate poses closer than this to the one before are merged into it (m, rad).
+constexpr double kPathStep = 0.002, kPathTurn = 2.0 * M_PI / 180.0;
 
 struct Item {
   size_t leaf;
@@ -253,6 +255,17 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
       Eigen::Isometry3d W = Eigen::Isometry3d::Identity();
       W.linear() = R_WG * T.linear();
       W.translation() = R_WG * T.translation();
+      // A pose within 2 mm and 2 degrees of the one before replaces it (a swing's settle creeps
+      // in steps a robot need not follow); the pre-placement pose stays the first, the goal the
+      // last.
+      if (c.intermediate_poses.size() >= 2) {
+        const Eigen::Isometry3d& P = c.intermediate_poses.back();
+        const double turn = Eigen::AngleAxisd(P.linear().transpose() * W.linear()).angle();
+        if ((P.translation() - W.translation()).norm() < kPathStep && turn < kPathTurn) {
+          c.intermediate_poses.back() = W;
+          continue;
+        }
+      }
       c.intermediate_poses.push_back(W);
     }
     out.push_back(std::move(c));

@@ -247,6 +247,17 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
   // Where friction alone fails (a loop on a round peg's shoulder: wide cones would hold it),
   // it slides round the peg, towards straight below it, before any swing.
   const Eigen::Vector3d slip = holds || r.balanced ? Eigen::Vector3d::Zero() : slipOf(support, com, prm);
+  if (!holds) {
+    // The settle the unbalanced wrench starts (the swing's descent takes it as one move).
+    double L = 1e-3;
+    for (const auto& p : support) L = std::max(L, (p.p_W - com).norm());
+    forces.unbalanced(-kUp, &r.settle_v, &r.settle_w);
+    const double scale = r.settle_v.norm() + r.settle_w.norm() * L;
+    if (scale > 1e-12) {
+      r.settle_v /= scale;
+      r.settle_w /= scale;
+    }
+  }
   if (holds) {
     r.failure = Failure::kNone;
   } else if (!slides(r, slip)) {

@@ -314,6 +314,8 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
       }
     };
     if (s.hanging && n.peg.known() && !n.swung && n.swings < kMaxSwings && !falls) {
+      n.settle_v = s.settle_v;
+      n.settle_w = s.settle_w;
       swinging_.push_back(std::move(n));  // threaded on a peg: to the pendulum's rest first
     } else if (s.hanging && s.stable) {
       leaf(true, true);  // hanging at the bottom of its swing (on a point or a line, too)
@@ -367,8 +369,11 @@ void TreeStepper::swingStep() {
   const auto t0 = Clock::now();
   constexpr double kSwingStart = 4.0 * M_PI / 180.0, kSwingEnd = 0.25 * M_PI / 180.0;
   // None; turns both ways about the two horizontal axes (along and across the peg) through the
-  // contacts' middle, and about the peg's axis; slides both ways across the peg.
-  constexpr int kMoves = 1 + 2 * 2 + 2 + 2;
+  // contacts' middle, and about the peg's axis; slides both ways across the peg; and, while
+  // gravity is not balanced, the settle its unbalanced wrench starts (down a peg that friction
+  // does not hold; a mug pressed against a rack's board turns along it, which no single move
+  // above can do).
+  constexpr int kMoves = 1 + 2 * 2 + 2 + 2 + 1;
   const double gap = 0.5 * ctx_.cd;
   std::vector<TranslationQuery> q;
   q.reserve(swinging_.size() * kMoves);
@@ -396,6 +401,13 @@ void TreeStepper::swingStep() {
     // Round the peg's axis: the loop slides round the peg (its contact moves over the peg).
     for (const double sign : {1.0, -1.0}) push(rotatedAbout(n.X_GO, n.peg.point, n.peg.axis, sign * t), gap + reach * t);
     for (const double sign : {1.0, -1.0}) push(translated(n.X_GO, toV3(sign * t * depth * across)), gap);
+    {
+      // A point at the contacts' reach moves t * depth (a slide's length).
+      const double len = t * depth;
+      const Eigen::Vector3d w = len * n.settle_w;
+      Rigid Y = w.norm() > 0 ? rotatedAbout(n.X_GO, com, w.normalized(), w.norm()) : n.X_GO;
+      push(translated(Y, toV3(len * n.settle_v)), gap + len);
+    }
   }
   std::vector<double> d;
   ctx_.backend.distance(q, d);
@@ -403,17 +415,19 @@ void TreeStepper::swingStep() {
     TreeNode& n = swinging_[i];
     int best = 0;
     double h[kMoves];
+    const size_t i0 = i * kMoves;
     for (int k = 0; k < kMoves; ++k) {
-      const TranslationQuery& tq = q[i * kMoves + k];
-      const double dk = d[i * kMoves + k];
+      const TranslationQuery& tq = q[i0 + k];
+      const double dk = d[i0 + k];
       h[k] = dk >= kInf || dk >= tq.tmax ? kInf : apply(tq.X_GO, n.com_O).z - dk;
+      if (k == kMoves - 1 && n.settle_v.squaredNorm() + n.settle_w.squaredNorm() == 0) h[k] = kInf;
       if (h[k] < h[best]) best = k;
     }
     ++n.swings;
     // A move counts when it lowers the centre of mass by a micrometre: at the last step (0.25
     // degrees) a centre of mass 1 mm off under a 6 cm pendulum drops 4 micrometres.
     if (best != 0 && h[best] < h[0] - kSwingDrop) {
-      n.X_GO = translated(q[i * kMoves + best].X_GO, v3(0, 0, -d[i * kMoves + best]));
+      n.X_GO = translated(q[i0 + best].X_GO, v3(0, 0, -d[i0 + best]));
       // The path's last pose is replaced while the swing goes on (nothing else moved it since).
       if (n.swing_pose == static_cast<int>(n.path.size()) - 1) n.path.back() = n.X_GO;
       else n.path.push_back(n.X_GO);
@@ -422,7 +436,7 @@ void TreeStepper::swingStep() {
       // ring spun 76 degrees to its rest must still tilt onto what it meets after it.
     } else {
       n.swing_step *= 0.5;
-      if (h[0] < kInf) n.X_GO = translated(q[i * kMoves].X_GO, v3(0, 0, -d[i * kMoves]));
+      if (h[0] < kInf) n.X_GO = translated(q[i0].X_GO, v3(0, 0, -d[i0]));
       n.swung = n.swing_step < kSwingEnd;
     }
     contact_.push_back(std::move(n));

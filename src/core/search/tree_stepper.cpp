@@ -361,7 +361,9 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
 // the peg's axis (the loop sliding round the peg) and moved both ways across the peg (a loop
 // sliding over it), each lowered back onto the support (V-A's translation); it takes the move
 // that lowers the centre of mass most, or halves the step when none does, from kSwingStart down
-// to kSwingEnd. Along the peg friction decides (the stability test), so that is not a move. The
+// to kSwingEnd. Along the peg friction decides (the stability test); where it does not hold,
+// or a wall stops a turn half-way, the settle of the unbalanced contact wrench
+// (ContactForces::unbalanced, first-order physics: no contact pushed in) is one more move. The
 // exact rotation to the next contact (V-C.2) does not serve here: a loop's own contacts, within a
 // collision distance of the peg all round it, stop a turn after a fraction of a degree. The path
 // keeps the swing's last pose only: the robot lets go, the object swings by itself.

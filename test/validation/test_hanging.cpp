@@ -189,6 +189,25 @@ TEST(Hanging, YcbMugTurnsAlongTheMugRacksBoardToARest) {
   expectStillHangsInBullet(mug, rack, *best);
 }
 
+// The mug scanned from above: its handle's opening, fused from one side, is found 10 mm
+// across where the true one is 12, and centred on a peg it meets the 14 mm knob on the
+// peg's tip. Threaded with the loop's centre off the peg's axis, it passes the knob and hangs,
+// and Bullet keeps the true mug there. Before, no start threaded it (no stable pose).
+TEST(Hanging, AMugScannedFromAboveThreadsPastTheKnobOfTheMugRacksPeg) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh scan = loadMesh(validation_test::sharedData() + "/scans/objects/mug_ycb025_upper_scan.ply");
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025.ply");
+  const Mesh rack = scenes::mugRack();
+  PlannerConfig c = twoThreads();
+  c.placement = PlacementKind::kHanging;
+  const PlanResult r = Planner().plan(scan, rack, c);
+  EXPECT_GT(r.stats.hanging_starts, 0);
+  const std::optional<Candidate> best = bestHung(scan, rack);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
+  expectStillHangsInBullet(mug, rack, *best);
+}
+
 // The same rack with its pegs rising 5 degrees, under half the friction angle: the mug stays
 // where it is threaded, clear of the board, and hangs there. Before, every peg rising more
 // than 2 degrees slid it down to the board's lower edge, where the YCB mug found no rest.

@@ -55,8 +55,15 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         // Threaded to the middle of that room or, where the sweep finds the middle blocked (a
         // wide loop on a steep arm meets the post behind it), to its far end: on a rising peg it
         // then slides to where it rests either way (below).
+        // Where a knob on the tip or a scan's rough loop leaves both blocked, the same with the
+        // loop's centre off the peg's axis by a third of the room round the peg, up, down and
+        // to either side (the loop's centre is found to a silhouette pixel).
+        const double off = (loop.radius - peg.half_width) / 3.0;
+        const Eigen::Vector3d side = peg.axis.cross(hang);
+        for (const Eigen::Vector3d& o : {Eigen::Vector3d::Zero().eval(), (off * hang).eval(), (-off * hang).eval(),
+                                         (off * side).eval(), (-off * side).eval()})
         for (const double along : {0.5 * (nearest + farthest), farthest}) {
-          const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis;
+          const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis + o;
           Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
           X.linear() = R;
           X.translation() = at - R * loop.centre;

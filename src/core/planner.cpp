@@ -126,6 +126,7 @@ TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaMod
                   config.threads, &st.steps, &st.tree_nodes};
   ctx.rock_settle = config.rock_settle;
   ctx.shape_uncertainty = scanned ? config.scan_noise : 0.0;  // a scan's crests are its noise's
+  ctx.penetration_limit = rad.r;  // as the result's guard (SearchMonitor::afterStep)
   return ctx;
 }
 

@@ -208,6 +208,38 @@ TEST(Hanging, AMugScannedFromAboveThreadsPastTheKnobOfTheMugRacksPeg) {
   expectStillHangsInBullet(mug, rack, *best);
 }
 
+// A board 12 cm tall with three 10 mm pegs 8 cm long rising 10 degrees (not in the suite).
+Mesh shortBoardOfRisingPegs() {
+  std::vector<Mesh> parts{scenes::box(0.5, 0.02, 0.12, {0, 0.01, 0.4})};
+  const Eigen::Vector3d d(0, -std::cos(10 * M_PI / 180), std::sin(10 * M_PI / 180));
+  const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), d).toRotationMatrix();
+  for (const double x : {-0.12, 0.0, 0.12}) {
+    Mesh peg = scenes::cylinder(0.005, 0.08, 12);
+    for (Eigen::Vector3d& v : peg.vertices) v = R * v + Eigen::Vector3d(x, 0, 0.42) + 0.04 * d;
+    parts.push_back(buildMesh(peg.vertices, peg.patches, "peg"));
+  }
+  return scenes::merge(parts, "short_board");
+}
+
+// The ring on that board swings against the board behind its peg. Each swing move is lowered
+// straight down, so a turn could leave it a few millimetres inside the board, and the result's
+// penetration guard then rejected every pose it came to (no stable pose). A move that leaves
+// it in the area is not taken: it hangs clear of the board, and Bullet keeps it there.
+TEST(Hanging, ARingSwingsAgainstAShortBoardWithoutEnteringIt) {
+  const Mesh ring = scenes::byName("ring");
+  const Mesh board = shortBoardOfRisingPegs();
+  const std::optional<Candidate> best = bestHung(ring, board);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
+  double deepest = -1;  // how far its vertices reach into the board (y > 0), over its height
+  for (const Eigen::Vector3d& v : ring.vertices) {
+    const Eigen::Vector3d w = best->X_WO * v;
+    if (w.z() > 0.34 && w.z() < 0.46) deepest = std::max(deepest, w.y());
+  }
+  EXPECT_LT(deepest, 0.002) << "the ring is " << 1000 * deepest << " mm inside the board";
+  expectStillHangsInBullet(ring, board, *best);
+}
+
 // The same rack with its pegs rising 5 degrees, under half the friction angle: the mug stays
 // where it is threaded, clear of the board, and hangs there. Before, every peg rising more
 // than 2 degrees slid it down to the board's lower edge, where the YCB mug found no rest.

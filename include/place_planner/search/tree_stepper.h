@@ -99,6 +99,9 @@ struct TreeContext {
   // roll holds only when its crests rise more than this too (rollStep): a crest the noise could
   // have made, or flattened, is no evidence of a rest. 0: the mesh is taken as exact.
   double shape_uncertainty = 0;
+  // A swing's move that leaves the object deeper than this in the area (penetration.h) is not
+  // taken (m); the planner's result guard uses the same depth. 0: not checked.
+  double penetration_limit = 0;
 };
 
 class TreeStepper {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "place_planner/judgement/penetration.h"
 #include "place_planner/search/contact_points.h"
 #include "place_planner/search/local_optimisation.h"
 #include "place_planner/infra/parallel_for.h"
@@ -423,7 +424,18 @@ void TreeStepper::swingStep() {
       const double dk = d[i0 + k];
       h[k] = dk >= kInf || dk >= tq.tmax ? kInf : apply(tq.X_GO, n.com_O).z - dk;
       if (k == kMoves - 1 && n.settle_v.squaredNorm() + n.settle_w.squaredNorm() == 0) h[k] = kInf;
-      if (h[k] < h[best]) best = k;
+    }
+    // The lowest move that leaves the object out of the area: lowered straight down, a turn can
+    // still push it sideways into a wall (a ring into the board behind its peg), which the
+    // result's penetration guard would then reject; the next lowest is taken instead.
+    for (int tries = 0; tries < kMoves; ++tries) {
+      best = 0;
+      for (int k = 1; k < kMoves; ++k)
+        if (h[k] < h[best]) best = k;
+      if (best == 0 || ctx_.penetration_limit <= 0 || h[best] >= h[0] - kSwingDrop) break;
+      const Rigid Y = translated(q[i0 + best].X_GO, v3(0, 0, -d[i0 + best]));
+      if (penetrationDepth(ctx_.om, ctx_.am, Y) <= ctx_.penetration_limit) break;
+      h[best] = kInf;
     }
     ++n.swings;
     // A move counts when it lowers the centre of mass by a micrometre: at the last step (0.25

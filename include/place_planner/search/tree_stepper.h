@@ -56,7 +56,8 @@ struct TreeNode {
   // Its last stability test's settle (Stability::settle_v, settle_w): zero when balanced.
   Eigen::Vector3d settle_v = Eigen::Vector3d::Zero(), settle_w = Eigen::Vector3d::Zero();
   // The peg it was threaded on, if any. The swing turns the loop round the peg and slides it
-  // across, never along it: along it friction decides.
+  // across; along it friction decides (only the settle, where friction does not hold, moves it
+  // along).
   PegLine peg;
 };
 

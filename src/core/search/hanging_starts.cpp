@@ -60,9 +60,10 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         // to either side (the loop's centre is found to a silhouette pixel).
         const double off = (loop.radius - peg.half_width) / 3.0;
         const Eigen::Vector3d side = peg.axis.cross(hang);
-        for (const Eigen::Vector3d& o : {Eigen::Vector3d::Zero().eval(), (off * hang).eval(), (-off * hang).eval(),
-                                         (off * side).eval(), (-off * side).eval()})
-        for (const double along : {0.5 * (nearest + farthest), farthest}) {
+        const Eigen::Vector3d offsets[] = {Eigen::Vector3d::Zero(), off * hang, -off * hang, off * side, -off * side};
+        for (int k = 0; k < 10; ++k) {
+          const Eigen::Vector3d& o = offsets[k / 2];
+          const double along = k % 2 ? farthest : 0.5 * (nearest + farthest);
           const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis + o;
           Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
           X.linear() = R;

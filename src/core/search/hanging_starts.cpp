@@ -18,7 +18,8 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   const double rising_slope = std::sin(0.5 * std::atan(friction));
   std::vector<HangingStart> starts;
   std::vector<TranslationQuery> sweeps;
-  std::vector<int> group;  // per start: its peg, loop and way round
+  std::vector<int> group;          // per start: its peg, loop and way round
+  std::vector<char> off_centre;    // per start: the loop's centre off the peg's axis
   int groups = 0;
   const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d com_O = toEigen(om.com);
@@ -80,18 +81,36 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
               TranslationQuery{toRigid(pre), toV3(h.approach), h.approach_distance + 0.01});
           starts.push_back(h);
           group.push_back(groups);
+          off_centre.push_back(k >= 2);
         }
         ++groups;
       }
     }
   if (starts.empty()) return starts;
   // Threaded by the sweep: its first contact (V-A's distance kernel) is past the threaded pose.
-  std::vector<double> t;
-  backend.distance(sweeps, t);
-  std::vector<HangingStart> free;
+  // The centred starts are swept first, the off-centre ones only for what that left unthreaded.
+  std::vector<double> t(starts.size(), -1.0);  // -1: not swept
+  auto isFree = [&](size_t i) { return t[i] >= starts[i].approach_distance + 1e-3; };
   std::vector<char> threaded(groups, 0);  // one start per peg, loop and way round: the first free
+  for (const char phase : {0, 1}) {
+    std::vector<TranslationQuery> batch;
+    std::vector<size_t> which;
+    for (size_t i = 0; i < starts.size(); ++i)
+      if (off_centre[i] == phase && !threaded[group[i]]) {
+        batch.push_back(sweeps[i]);
+        which.push_back(i);
+      }
+    if (batch.empty()) continue;
+    std::vector<double> tb;
+    backend.distance(batch, tb);
+    for (size_t j = 0; j < which.size(); ++j) t[which[j]] = tb[j];
+    for (size_t i = 0; i < starts.size(); ++i)
+      if (isFree(i)) threaded[group[i]] = 1;
+  }
+  std::fill(threaded.begin(), threaded.end(), 0);
+  std::vector<HangingStart> free;
   for (size_t i = 0; i < starts.size(); ++i)
-    if (!threaded[group[i]] && t[i] >= starts[i].approach_distance + 1e-3) {
+    if (!threaded[group[i]] && isFree(i)) {
       threaded[group[i]] = 1;
       free.push_back(starts[i]);
     }

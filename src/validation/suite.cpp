@@ -187,7 +187,7 @@ std::vector<ScenePair> hangingPairs(const std::string& data_dir) {
   objects.push_back({"loop_mug", "builtin:loop_mug", "", "mesh"});
   objects.push_back({"tape_roll", "builtin:tape_roll", "", "mesh"});
   std::vector<ScenePair> pairs;
-  for (const char* area : {"peg_wall", "peg_wall_rising", "mug_tree", "mug_rack"})
+  for (const char* area : {"peg_wall", "peg_wall_rising", "mug_tree", "mug_rack", "cup_hooks"})
     for (const Obj& o : objects) {
       ScenePair p;
       p.name = o.name + "@" + area;

@@ -80,6 +80,23 @@ TEST(Pegs, KnobbedPegsAndSteepArmsAreFoundWholeAlongTheirAxes) {
   }
 }
 
+// Cup hooks under a shelf: each hook's arm is free beyond both its ends (its stem is as thin as
+// it), so it is a peg each way, horizontal along y, about as long as the arm between the stem
+// and the arm's end; the upright stem and tip are no pegs. The threading sweep then finds that
+// a loop gets on from the tip's end only (Hanging.YcbMugIsLiftedOverACupHooksTipAndHangsOnItsArm).
+TEST(Pegs, ACupHooksArmIsAPegBothWays) {
+  const std::vector<Peg> pegs = pegsOf(scenes::cupHooks());
+  ASSERT_EQ(pegs.size(), 6u);
+  int towards_tip = 0;
+  for (const Peg& p : pegs) {
+    EXPECT_GT(std::abs(p.axis.y()), std::cos(3 * M_PI / 180));
+    EXPECT_NEAR(p.point.z(), 0.35, 0.003);
+    EXPECT_NEAR(p.to_tip + p.to_base, 0.0385, 0.005);
+    towards_tip += p.axis.y() < 0;
+  }
+  EXPECT_EQ(towards_tip, 3);
+}
+
 TEST(Loops, AHandlesOpeningAndARingsHoleAreFoundSolidsHaveNone) {
   // The loop mug's handle: an opening 5.8 cm tall and 2.4 cm deep, through y.
   const std::vector<Loop> mug = findLoops(scenes::loopMug());

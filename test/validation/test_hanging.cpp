@@ -210,6 +210,32 @@ TEST(Hanging, AMugScannedFromAboveThreadsPastTheKnobOfTheMugRacksPeg) {
   expectStillHangsInBullet(mug, rack, best);
 }
 
+// Cup hooks under a shelf (J hooks: a stem down from the board, an arm out, a tip turned up 1
+// cm). The arm is free beyond both its ends (the stem is as thin as the arm), and the mug's
+// body reaches farther back than the 3.5 cm arm is long. Only the far end is threaded, lifted:
+// the handle passes over the turned-up tip, then comes down on the arm. The mug hangs by its
+// handle, its centre of mass below the arm, and Bullet keeps it there.
+TEST(Hanging, YcbMugIsLiftedOverACupHooksTipAndHangsOnItsArm) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh hooks = scenes::cupHooks();
+  const std::optional<Candidate> best = bestHung(mug, hooks);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
+  // Threaded towards the stem (+y) from beyond the tip, first pose above the goal (lifted).
+  EXPECT_GT(best->placement.approach.direction.y(), 0.95) << "not threaded along the arm from its tip";
+  ASSERT_FALSE(best->intermediate_poses.empty());
+  EXPECT_LT(best->placement.pre_place_W.translation().y(), -0.05) << "the approach does not start past the tip";
+  EXPECT_GT(best->placement.pre_place_W.translation().z(), best->X_WO.translation().z() + 0.003)
+      << "not lifted over the tip";
+  const Eigen::Vector3d com = best->X_WO * mug.properties.center_of_mass;
+  int on_arm = 0;
+  for (const ContactPoint& p : best->contacts)
+    on_arm += p.p_W.z() > com.z() + 0.01 && std::abs(p.p_W.z() - 0.35) < 0.006 && p.p_W.y() < 0 && p.p_W.y() > -0.04;
+  EXPECT_GT(on_arm, 0) << "it does not hang from a hook's arm";
+  expectStillHangsInBullet(mug, hooks, *best);
+}
+
 // A board 12 cm tall with three 10 mm pegs 8 cm long rising 10 degrees (not in the suite).
 Mesh shortBoardOfRisingPegs() {
   std::vector<Mesh> parts{scenes::box(0.5, 0.02, 0.12, {0, 0.01, 0.4})};

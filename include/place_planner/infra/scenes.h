@@ -49,6 +49,10 @@ Mesh mugTree();
 // 8 mm thick and 8 cm long rising `rise_deg` towards -y, each with a knob on its end. What
 // hangs from a peg reaches below the board.
 Mesh mugRack(double rise_deg = 15.0);
+// Cup hooks under a shelf: a board 0.6 x 0.2 m (its underside at z = 0.4) with three J hooks of
+// 6 mm wire, each a stem 5 cm down, an arm 3.5 cm out towards -y and a tip turned up 1 cm. A
+// loop is lifted over the tip, then lowered onto the arm.
+Mesh cupHooks();
 // Demo objects (mesh frame at their base centre, like a scan).
 Mesh mug();           // cylinder body with a handle, 0.08 m diameter
 Mesh plate();         // flat disc 0.24 m, 2 cm thick rim
@@ -56,7 +60,7 @@ Mesh pen();           // thin cylinder 0.14 m long
 Mesh loopMug();       // the mug with a handle it can hang by: an opening 5.8 x 2.4 cm
 
 // Names accepted by byName(): table, dish_rack, open_box, binder_stack, shelf, peg_wall,
-// peg_wall_rising (its pegs rising 10 degrees), mug_tree, mug_rack, mug, loop_mug, ring (torus 6 cm
+// peg_wall_rising (its pegs rising 10 degrees), mug_tree, mug_rack, cup_hooks, mug, loop_mug, ring (torus 6 cm
 // across, 12 mm thick), tape_roll (tube 11 cm across, a hole 7.6 cm across, 4.8 cm deep), plate, pen, cube.
 Mesh byName(const std::string& name);
 std::vector<std::string> areaNames();

@@ -206,6 +206,20 @@ Mesh mugRack(double rise_deg) {
   return b.build("mug_rack");
 }
 
+Mesh cupHooks() {
+  Builder b;
+  b.add(box(0.6, 0.2, 0.02, {0, 0, 0.41}));
+  // Three hooks of 6 mm wire 20 cm apart, each a stem 5 cm down from the board's underside, an
+  // arm 3.5 cm out towards -y and a tip turned up 1 cm at its end.
+  const Eigen::Matrix3d along_y = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (const double x : {-0.2, 0.0, 0.2}) {
+    b.add(cylinder(0.003, 0.05, 12), Eigen::Matrix3d::Identity(), {x, 0, 0.375});
+    b.add(cylinder(0.003, 0.041, 12), along_y, {x, -0.0175, 0.35});
+    b.add(cylinder(0.003, 0.01, 12), Eigen::Matrix3d::Identity(), {x, -0.035, 0.355});
+  }
+  return b.build("cup_hooks");
+}
+
 Mesh tube(double r_in, double r_out, double h, int segments) {
   std::vector<Eigen::Vector3d> v;
   std::vector<std::vector<int>> f;
@@ -288,10 +302,11 @@ Mesh byName(const std::string& n) {
   if (n == "loop_mug") return loopMug();
   if (n == "ring") return torus(0.03, 0.006);
   if (n == "mug_rack") return mugRack();
+  if (n == "cup_hooks") return cupHooks();
   if (n == "tape_roll") return tube(0.038, 0.055, 0.048);
   if (n == "cube") return box(0.1, 0.1, 0.1, {0, 0, 0.05});
   throw std::invalid_argument("unknown built-in scene '" + n +
-                              "' (table, dish_rack, open_box, binder_stack, shelf, peg_wall, peg_wall_rising, mug_tree, mug_rack, mug, loop_mug, ring, tape_roll, plate, pen, cube)");
+                              "' (table, dish_rack, open_box, binder_stack, shelf, peg_wall, peg_wall_rising, mug_tree, mug_rack, cup_hooks, mug, loop_mug, ring, tape_roll, plate, pen, cube)");
 }
 
 std::vector<std::string> areaNames() { return {"table", "dish_rack", "open_box", "binder_stack"}; }

@@ -50,19 +50,27 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         // its thickness (at most 1 cm: a roll of tape's 5 cm need not be), so a swing or a push
         // meets neither.
         const double length = peg.to_base + peg.to_tip;
-        const double nearest = back + cd + 0.001,
-                     farthest = length - 0.5 * loop.thickness - std::min(0.5 * loop.thickness, 0.01);
-        if (nearest > farthest) continue;
+        // Where the object reaches farther back than the peg is long (a mug's body below a cup
+        // hook's short arm), only the far end is tried: the sweep finds whether what hangs below
+        // the peg clears its base (a wall does not let it; a hook's stem above the arm does).
+        const double farthest = length - 0.5 * loop.thickness - std::min(0.5 * loop.thickness, 0.01);
+        const double nearest = std::min(back + cd + 0.001, farthest);
+        if (farthest <= 0) continue;
         // Threaded to the middle of that room or, where the sweep finds the middle blocked (a
         // wide loop on a steep arm meets the post behind it), to its far end: on a rising peg it
         // then slides to where it rests either way (below).
         // Where a knob on the tip or a scan's rough loop leaves both blocked, the same with the
         // loop's centre off the peg's axis by a third of the room round the peg, up, down and
-        // to either side (the loop's centre is found to a silhouette pixel).
-        const double off = (loop.radius - peg.half_width) / 3.0;
+        // to either side (the loop's centre is found to a silhouette pixel); and lifted by all
+        // that room but a collision distance and a millimetre, the peg just inside the loop's
+        // bottom, so the opening passes over a tip that turns up (a cup hook), then lowered.
+        const double room = loop.radius - peg.half_width;
+        const double off = room / 3.0, lift = std::max(off, room - cd - 0.001);
         const Eigen::Vector3d side = peg.axis.cross(hang);
-        const Eigen::Vector3d offsets[] = {Eigen::Vector3d::Zero(), off * hang, -off * hang, off * side, -off * side};
-        for (int k = 0; k < 10; ++k) {
+        const Eigen::Vector3d offsets[] = {Eigen::Vector3d::Zero(), off * hang, -off * hang, off * side, -off * side,
+                                           -lift * hang};
+        for (int k = 0; k < 12; ++k) {
+          if (k % 2 == 0 && nearest >= farthest) continue;  // the middle is the far end
           const Eigen::Vector3d& o = offsets[k / 2];
           const double along = k % 2 ? farthest : 0.5 * (nearest + farthest);
           const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis + o;

@@ -183,9 +183,9 @@ std::vector<Peg> findPegs(const AreaModel& am, const PegParams& p, const StopSig
       const double to_base = sign > 0 ? sp.behind : sp.ahead;
       to_tip += knobBeyond(am, c + (to_tip + 2 * kEps) * a, a, side, half, p.max_thickness);
       const Eigen::Vector3d tip = c + (to_tip + 2 * kEps) * a;
+      // Free at both ends (a loose bar; a cup hook's arm, whose stem beyond one end is as thin
+      // as it): both, and the threading sweep finds which end a loop gets on by.
       if (ray(am, tip, a, p.min_tip_free) < p.min_tip_free) continue;
-      if (sign < 0 && ray(am, c + (sp.ahead + 2 * kEps) * axis, axis, p.min_tip_free) >= p.min_tip_free)
-        continue;  // free at both ends: a loose bar, taken once
       found.push_back(Peg{c, a, half, to_tip, to_base});
     }
   }

@@ -48,7 +48,9 @@ class ContactForces {
   // contacts' reach moves |w| reach). It never pushes a contact into its surface (the NNLS
   // optimality: every cone edge's velocity is >= 0) and gravity does work along it (the
   // centre of mass sinks), so it is the first-order settle. Zero when balanced.
-  void unbalanced(const Eigen::Vector3d& f_ext, Eigen::Vector3d* v, Eigen::Vector3d* w) const;
+  // `forces`: balances()'s cone-edge weights for the same f_ext, when solved already (not again).
+  void unbalanced(const Eigen::Vector3d& f_ext, Eigen::Vector3d* v, Eigen::Vector3d* w,
+                  const Eigen::VectorXd* forces = nullptr) const;
   bool empty() const { return A_.cols() == 0; }
   // The force on contact i (G, weights) of the cone-edge weights `forces` (balances()).
   Eigen::Vector3d contactForce(const Eigen::VectorXd& forces, size_t i) const;

@@ -132,11 +132,13 @@ bool ContactForces::balances(const Eigen::Vector3d& f_ext, Eigen::VectorXd* forc
   return residual < 1e-4 * f_ext.norm() && load <= max_load_ * f_ext.norm();
 }
 
-void ContactForces::unbalanced(const Eigen::Vector3d& f_ext, Eigen::Vector3d* v, Eigen::Vector3d* w) const {
+void ContactForces::unbalanced(const Eigen::Vector3d& f_ext, Eigen::Vector3d* v, Eigen::Vector3d* w,
+                               const Eigen::VectorXd* forces) const {
   Eigen::Matrix<double, 7, 1> b = Eigen::Matrix<double, 7, 1>::Zero();
   b.head<3>() = -f_ext;
   Eigen::VectorXd x = Eigen::VectorXd::Zero(A_.cols());
-  if (A_.cols() > 0) nnlsRows<7>(A_, b, &x);
+  if (forces && forces->size() == A_.cols()) x = *forces;
+  else if (A_.cols() > 0) nnlsRows<7>(A_, b, &x);
   // The net wrench on the object: the contact forces plus f_ext (torque rows over reach_).
   const Eigen::Matrix<double, 6, 1> r = A_.topRows(6) * x - b.head<6>();
   const bool balanced = r.norm() < 1e-4 * f_ext.norm();

@@ -206,7 +206,8 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
   if (one_support)
     for (auto& p : support) p.n_W = nbar.normalized();
   ContactForces forces = forceModel(support, com, prm);
-  r.balanced = forces.balances(-kUp);
+  Eigen::VectorXd weights;  // the solve's forces: the settle below reads its residual
+  r.balanced = forces.balances(-kUp, &weights);
   // A pendulum rests where its centre of mass is straight below its support, which contacts
   // within tol of touching locate only roughly: a centre of mass within tol, horizontally, of
   // the segments between its contacts is at rest to the model's resolution (and to the swing's,
@@ -251,7 +252,7 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
     // The settle the unbalanced wrench starts (the swing's descent takes it as one move).
     double L = 1e-3;
     for (const auto& p : support) L = std::max(L, (p.p_W - com).norm());
-    forces.unbalanced(-kUp, &r.settle_v, &r.settle_w);
+    forces.unbalanced(-kUp, &r.settle_v, &r.settle_w, &weights);
     const double scale = r.settle_v.norm() + r.settle_w.norm() * L;
     if (scale > 1e-12) {
       r.settle_v /= scale;

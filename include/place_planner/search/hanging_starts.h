@@ -22,8 +22,10 @@ struct HangingStart {
 
 // For each peg (in order) and each loop wide enough for it, both ways round the peg: the loop's
 // axis along the peg, turned about it so that the centre of mass hangs below the loop, and far
-// enough along the peg that the object clears the peg's base. Kept when the object's sphere
-// model sweeps along the peg from beyond its tip to that pose without touching the area. On a
+// enough along the peg that the object clears the peg's base (or, where it reaches back past
+// the room, at the far end only), centred on the peg, off it a little or lifted over a tip that
+// turns up. Kept when the object's sphere model sweeps along the peg from beyond its tip to
+// that pose without touching the area (the first free of each peg, loop and way round). On a
 // peg rising more than half the friction angle atan(friction) / 2 it is then slid down the peg
 // to its first contact there (the wall, a post), where it would come to rest.
 std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,

@@ -71,6 +71,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
                                            -lift * hang};
         for (int k = 0; k < 12; ++k) {
           if (k % 2 == 0 && nearest >= farthest) continue;  // the middle is the far end
+          if (k / 2 == 5 && lift <= off) continue;          // a loop too tight to lift: as off-centre up
           const Eigen::Vector3d& o = offsets[k / 2];
           const double along = k % 2 ? farthest : 0.5 * (nearest + farthest);
           const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis + o;

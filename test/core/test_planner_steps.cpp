@@ -13,6 +13,8 @@
 #include "place_planner/judgement/contact_forces.h"
 #include "place_planner/judgement/stability.h"
 #include "place_planner/judgement/penetration.h"
+#include "place_planner/judgement/ranking.h"
+#include "place_planner/model/scene.h"
 #include "place_planner/infra/scenes.h"
 #include "place_planner/search/tilt_axis.h"
 #include "test_helpers.h"
@@ -418,4 +420,40 @@ TEST(Penetration, DepthAlongTheSurfaceNormal) {
     X.translation() = (0.01 - inside + reach) * n;
     EXPECT_NEAR(penetrationDepth(om, am, toRigid(X)), inside, 1e-4) << inside;
   }
+}
+
+TEST(Ranking, TheLargerTippingMarginRanksFirstAmongEqualPoses) {
+  // Two stable poses of a 10 cm cube on a flat top, alike in Q, contacts and robust share; one
+  // tips off after 2 degrees of tilt, the other after 8. The tie-break alone (nearer the frame's
+  // axis first) would put the 2-degree one first.
+  auto leafAt = [](double x) {
+    TreeLeaf l;
+    l.X_GO = toRigid(Eigen::Isometry3d(Eigen::Translation3d(x, 0, 0.05)));
+    l.stable = l.supported = true;
+    l.quality = 0.8;
+    for (const double cx : {-0.05, 0.05})
+      for (const double cy : {-0.05, 0.05}) {
+        ContactPoint c;
+        c.p_W = Eigen::Vector3d(x + cx, cy, 0);
+        c.n_area_W = Eigen::Vector3d::UnitZ();
+        l.contacts.push_back(c);
+      }
+    return l;
+  };
+  const std::vector<TreeLeaf> leaves{leafAt(0.0), leafAt(0.4)};
+  const std::vector<StartKind> kinds{StartKind::kPrincipalAxis, StartKind::kPrincipalAxis};
+  const std::vector<Eigen::Vector3d> fps{Eigen::Vector3d::Zero(), Eigen::Vector3d(0.4, 0, 0)};
+  RankingInput in{leaves, kinds, fps, Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(), 0.087};
+  const RobustnessCheck check = [](const std::vector<size_t>& idx) {
+    std::vector<Robustness> out;
+    for (const size_t i : idx) out.push_back(Robustness{12, 12, (i == 0 ? 2.0 : 8.0) * M_PI / 180});
+    return out;
+  };
+  PlannerConfig config;
+  PlanStats stats;
+  const std::vector<Candidate> c = rankCandidates(in, config, check, &stats);
+  ASSERT_EQ(c.size(), 2u);
+  ASSERT_TRUE(c[0].stable && c[1].stable);
+  EXPECT_NEAR(c[0].X_WO.translation().x(), 0.4, 1e-9);
+  EXPECT_NEAR(c[0].robustness.min_tipping_angle, 8.0 * M_PI / 180, 1e-12);
 }

@@ -30,6 +30,8 @@ constexpr double kUnstableShareWeight = 0.05;
 // that held, Robustness::min_tipping_angle) adds to the score up to kTipFull, a little more than
 // the releases' own tilt (3 degrees): a pose that a 2-3 degree nudge sends off ranks behind one
 // that takes 5. Beyond that more margin buys nothing (the validator's turn limit is 5 degrees).
+// A hanging pose's margin is negative where a wall below lowers its contacts' centre past the
+// centre of mass (tipping_angle, stability.cpp): it counts as none.
 // Measured: a scanned mug on a peg with 2.5 degrees to spare, ranked first on Q, swung off its
 // peg in Bullet (hanging suite, best 36/40 -> 37/40, top-3 105 -> 106/111); a 10 degree cap
 // also reorders lying bottles whose margins differ at 3-10 degrees (scan suite top-3 145 -> 144).
@@ -51,7 +53,7 @@ struct Item {
   double score() const {
     const double share = checked ? robustness.share() : 1.0;
     const double w = stable ? kShareWeight : kUnstableShareWeight;
-    const double tip = checked ? std::min(robustness.min_tipping_angle / kTipFull, 1.0) : 1.0;
+    const double tip = checked ? std::clamp(robustness.min_tipping_angle / kTipFull, 0.0, 1.0) : 1.0;
     return quality - 0.05 * reorientation / M_PI - w * (1.0 - share) + kPushWeight * push.mean + kTipWeight * tip;
   }
 };

@@ -183,22 +183,27 @@ class OneResultPerGoal(unittest.TestCase):
                 self.lock.wait(min(left, 0.05))
             return True
 
-    def connections(self, new_since=None):
-        """Whether the raw publishers and subscribers reach the server (with new_since: through
-        connections made after that set of connections was taken)."""
-        def fresh(conns):
-            return [c for c in conns if new_since is None or id(c) not in new_since]
-        return (fresh(self.goal_pub.impl.connections) and fresh(self.cancel_pub.impl.connections) and
-                fresh(self.result_sub.impl.connections) and fresh(self.status_sub.impl.connections))
+    def missing_connections(self, new_since=None):
+        """The raw topics that do not reach the server yet (with new_since: through a connection
+        made after that list of connections was taken)."""
+        ends = (("goal", self.goal_pub), ("cancel", self.cancel_pub), ("result", self.result_sub),
+                ("status", self.status_sub))
+        return [name for name, end in ends
+                if not any(new_since is None or not any(c is o for o in new_since)
+                           for c in end.impl.connections)]
 
-    def connection_ids(self):
-        return {id(c) for p in (self.goal_pub, self.cancel_pub, self.result_sub, self.status_sub)
-                for c in p.impl.connections}
+    def current_connections(self):
+        """The connections now, the objects themselves: held here, a closed one is not freed, so a
+        new connection cannot take its id() and pass for old."""
+        return [c for p in (self.goal_pub, self.cancel_pub, self.result_sub, self.status_sub)
+                for c in p.impl.connections]
 
     def wait_for_server(self, new_since=None, timeout=COME_BACK):
         deadline = time.monotonic() + timeout
-        while not self.connections(new_since):
-            self.assertLess(time.monotonic(), deadline, "the raw topics never connected to the node")
+        while self.missing_connections(new_since):
+            if time.monotonic() >= deadline:
+                self.fail("the raw topics never connected to the node within %.0f s: %s" %
+                          (timeout, ", ".join(self.missing_connections(new_since))))
             time.sleep(0.02)
         # The status list is latched: a message arrives once the status topic is connected.
         count = self.status_count
@@ -394,7 +399,7 @@ class OneResultPerGoal(unittest.TestCase):
         self.wait_for_server()
         pid = node_pid()
         self.assertIsNotNone(pid, "no pid for %s" % NODE)
-        before = self.connection_ids()
+        before = self.current_connections()
         lost = self.new_id("in-flight-when-killed")
         self.send_goal(lost, long_goal())
         time.sleep(0.05)

@@ -183,20 +183,21 @@ class OneResultPerGoal(unittest.TestCase):
                 self.lock.wait(min(left, 0.05))
             return True
 
+    def ends(self):
+        return (("goal", self.goal_pub), ("cancel", self.cancel_pub), ("result", self.result_sub),
+                ("status", self.status_sub))
+
     def missing_connections(self, new_since=None):
         """The raw topics that do not reach the server yet (with new_since: through a connection
-        made after that list of connections was taken)."""
-        ends = (("goal", self.goal_pub), ("cancel", self.cancel_pub), ("result", self.result_sub),
-                ("status", self.status_sub))
-        return [name for name, end in ends
-                if not any(new_since is None or not any(c is o for o in new_since)
-                           for c in end.impl.connections)]
+        that is not in that list)."""
+        def new(c):
+            return new_since is None or all(c is not o for o in new_since)
+        return [name for name, end in self.ends() if not any(new(c) for c in end.impl.connections)]
 
     def current_connections(self):
         """The connections now, the objects themselves: held here, a closed one is not freed, so a
         new connection cannot take its id() and pass for old."""
-        return [c for p in (self.goal_pub, self.cancel_pub, self.result_sub, self.status_sub)
-                for c in p.impl.connections]
+        return [c for _, end in self.ends() for c in end.impl.connections]
 
     def wait_for_server(self, new_since=None, timeout=COME_BACK):
         deadline = time.monotonic() + timeout

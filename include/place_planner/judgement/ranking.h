@@ -37,7 +37,7 @@ using PlacementCheck = std::function<Placement(size_t)>;
 // Ranks stable before not stable, then by config.rank_order (kLowest: centre of mass height in
 // 5 mm steps; kNearest: distance to prefer_near in 5 mm steps), then by the score
 //   Q - 0.05 * reorientation / pi - w * (1 - robust share) + 0.25 * mean push resistance
-//     + 0.05 * min(smallest tipping margin of the held releases / 5 deg, 1)
+//     + 0.05 * clamp(smallest tipping margin of the held releases / 5 deg, 0, 1)
 // (re-orientation: the angle from the held orientation, a secondary key: a half turn costs as
 // much as 0.05 of Q; w = 1 for a stable pose, where a failed release of 12 costs 0.083, and
 // 0.05 for one that is not, ranking.cpp). It merges poses within merge_distance and

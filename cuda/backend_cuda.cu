@@ -43,27 +43,36 @@ struct DeviceArea {
   AreaView view;
 };
 
-// The last few areas' device copies (the host cache holds four models too).
+// The last few areas' device copies (the host cache holds four models too), and whether this
+// device has the rotation kernels' deep stacks. Neither survives cudaDeviceReset.
+std::mutex g_device_state_mutex;
+std::list<std::shared_ptr<DeviceArea>> g_area_cache;
+bool g_stack_limit_set = false;
+
 std::shared_ptr<DeviceArea> deviceArea(const AreaModel& a) {
-  static std::mutex mutex;
-  static std::list<std::shared_ptr<DeviceArea>> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  for (const auto& d : cache)
+  std::lock_guard<std::mutex> lock(g_device_state_mutex);
+  for (const auto& d : g_area_cache)
     if (d->id == a.id) return d;
   auto d = std::make_shared<DeviceArea>();
   d->id = a.id;
   d->view = makeAreaView(a, d->arrays);
-  cache.push_front(d);
-  if (cache.size() > 4) cache.pop_back();
+  g_area_cache.push_front(d);
+  if (g_area_cache.size() > 4) g_area_cache.pop_back();
   return d;
+}
+
+// Deep per-thread traversal stacks for the rotation kernels: once per device context.
+void ensureStackLimit() {
+  std::lock_guard<std::mutex> lock(g_device_state_mutex);
+  if (g_stack_limit_set) return;
+  PP_CUDA_CHECK(cudaDeviceSetLimit(cudaLimitStackSize, 16384));
+  g_stack_limit_set = true;
 }
 
 class CudaDevice {
  public:
   CudaDevice(const ObjectModel& o, const AreaModel& a) {
-    // Deep per-thread traversal stacks for the rotation kernels: set once per process.
-    static std::once_flag limit;
-    std::call_once(limit, [] { PP_CUDA_CHECK(cudaDeviceSetLimit(cudaLimitStackSize, 16384)); });
+    ensureStackLimit();
     PP_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
     obj_ = makeObjectView(o, obj_arrays_);
     area_ = deviceArea(a);
@@ -144,6 +153,14 @@ class CudaDevice {
 };
 
 }  // namespace
+
+namespace cuda {
+void forgetDeviceState() {
+  std::lock_guard<std::mutex> lock(g_device_state_mutex);
+  g_area_cache.clear();
+  g_stack_limit_set = false;
+}
+}  // namespace cuda
 
 std::unique_ptr<Backend> makeCudaBackend(const ObjectModel& object, const AreaModel& area,
                                          const TiltParams& tilt) {

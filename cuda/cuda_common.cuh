@@ -43,6 +43,10 @@ class DeviceBuffer {
   size_t n_;
 };
 
+// Drops what lives in the device context (the areas' device copies, the stack limit), before
+// cudaDeviceReset frees it: a plan after cuda::resetDevice() uploads again.
+void forgetDeviceState();
+
 inline unsigned blocksFor(size_t n, unsigned threads = 256) {
   return static_cast<unsigned>((n + threads - 1) / threads);
 }

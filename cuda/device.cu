@@ -18,6 +18,7 @@ void markUnusable(const std::string& why) {
 void resetDevice() {
   std::lock_guard<std::mutex> lock(g_fault_mutex);
   g_fault.clear();
+  forgetDeviceState();
   cudaDeviceReset();
 }
 

@@ -130,7 +130,7 @@ struct PlanStats {
   StepTimes steps;
   double robustness_ms = 0.0;      // wall time of the robustness check
   std::string backend;             // "cpu" or "cuda"
-  std::string backend_note;        // why `auto` chose the CPU ("no usable GPU (...)"), else empty
+  std::string backend_note;        // with backend auto: which backend it chose and why, else empty
   double sphere_radius = 0.0;      // as used (derived when the config says 0)
 };
 

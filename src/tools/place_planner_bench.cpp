@@ -134,7 +134,12 @@ void BM_BooksStackCudaPrincipalAxis(benchmark::State& s) {
 }
 // An area approached from the side: the built-in shelf unit (scenes::shelfUnit, 15k triangles,
 // 2.4 m tall, open to -y), the 1k mug along d_vis = +y, about 200 floor points, cold.
-void BM_ShelfFromSideCold(benchmark::State& state) {
+void shelfFromSide(benchmark::State& state, BackendKind backend) {
+  std::string why;
+  if (backend == BackendKind::kCuda && !cuda::available(&why)) {
+    state.SkipWithError(("no usable GPU: " + why).c_str());
+    return;
+  }
   const Mesh* object = mesh("objects/mug_ycb025_1k.ply");
   if (!object) {
     state.SkipWithError(("../shared/data not found at " + g_data).c_str());
@@ -145,6 +150,7 @@ void BM_ShelfFromSideCold(benchmark::State& state) {
   cfg.approach = Eigen::Vector3d(0, 1, 0);
   cfg.floor_point_spacing = 0.11;
   cfg.threads = 2;
+  cfg.backend = backend;
   static const Planner planner;
   PlanResult r;
   double contacts = 0, setup = 0;
@@ -164,6 +170,8 @@ void BM_ShelfFromSideCold(benchmark::State& state) {
   state.counters["setup_ms"] = setup / n;
   state.counters["contacts_ms"] = contacts / n;
 }
+void BM_ShelfFromSideCold(benchmark::State& s) { shelfFromSide(s, BackendKind::kCpu); }
+void BM_ShelfFromSideCudaCold(benchmark::State& s) { shelfFromSide(s, BackendKind::kCuda); }
 void BM_DishRackWarm(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", false); }
 void BM_DishRackCold(benchmark::State& s) { runPlan(s, "areas/dish_rack.ply", true); }
 
@@ -177,6 +185,7 @@ BENCHMARK(BM_BooksStackCudaPrincipalAxis)->Arg(1000)->Unit(benchmark::kMilliseco
 BENCHMARK(BM_DishRackWarm)->Arg(200)->Arg(500)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DishRackCold)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ShelfFromSideCold)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ShelfFromSideCudaCold)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)

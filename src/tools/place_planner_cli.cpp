@@ -471,7 +471,7 @@ int main(int argc, char** argv) {
   app.add_option("--json", json_path, "write the answer as JSON to this file; - = stdout (the report then goes to stderr)")
       ->type_name("OUT");
   bool verbose = false;
-  app.add_flag("-v,--verbose", verbose, "also say why the CPU backend was chosen (no usable GPU)");
+  app.add_flag("-v,--verbose", verbose, "also say which backend auto chose, and why");
   // Bounded work (doc/reliability.md): the limits of PlannerConfig.
   app.add_option("--max-triangles", c.max_triangles, "per mesh; larger ones are decimated")->capture_default_str();
   app.add_option("--max-floor-points", c.max_floor_points, "rays cast; a finer spacing is coarsened")

@@ -185,6 +185,29 @@ TEST(BackendParity, DeviceFaultSendsAutoToTheCpuUntilReset) {
   }
 #endif
   cuda::resetDevice();
+  why.clear();  // available() writes the reason only when it answers false
   cuda::available(&why);
   EXPECT_EQ(why.find("simulated illegal address"), std::string::npos) << "reset did not clear the fault: " << why;
+}
+
+// cudaDeviceReset frees every device allocation and limit: a planner whose area model was
+// uploaded before the reset must upload it again, not read the freed copy.
+TEST(BackendParity, PlansOnACachedAreaAfterAReset) {
+  std::string why;
+  if (!cuda::available(&why)) GTEST_SKIP() << "no usable GPU (" << why << "): the CUDA backend cannot run here";
+  Planner planner;  // one planner: its host cache keeps the area model (and its id) across the reset
+  PlannerConfig c;
+  c.threads = 2;
+  c.backend = BackendKind::kCuda;
+  const PlanResult before = planner.plan(scenes::mug(), scenes::table(), c);
+  ASSERT_FALSE(before.candidates.empty());
+  cuda::resetDevice();
+  PlanResult after;
+  ASSERT_NO_THROW(after = planner.plan(scenes::mug(), scenes::table(), c));
+  EXPECT_EQ(after.stats.backend, "cuda");
+  ASSERT_EQ(before.candidates.size(), after.candidates.size());
+  for (size_t i = 0; i < before.candidates.size(); ++i)
+    EXPECT_LT((before.candidates[i].X_WO.translation() - after.candidates[i].X_WO.translation()).norm(), 1e-9)
+        << "candidate " << i;
+  EXPECT_TRUE(cuda::available(&why)) << why;
 }

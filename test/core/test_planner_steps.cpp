@@ -9,6 +9,7 @@
 #include "place_planner/kernels/geometry.h"
 #include "place_planner/planner.h"
 #include "place_planner/search/pre_orientation.h"
+#include "place_planner/search/start_orientations.h"
 #include "place_planner/judgement/quality.h"
 #include "place_planner/judgement/contact_forces.h"
 #include "place_planner/judgement/stability.h"
@@ -154,6 +155,45 @@ TEST(PreOrientation, PrincipalAxisAlongApproach) {
   EXPECT_NEAR(std::abs((R[0] * pen.properties.k1()).z()), 1.0, 1e-9);
   EXPECT_EQ(preOrientations(pen.properties, R_start, Eigen::Vector3d(0, 0, -1), OrientationMode::kAllAxes).size(), 6u);
   EXPECT_TRUE(preOrientations(pen.properties, R_start, Eigen::Vector3d(0, 0, -1), OrientationMode::kKeep)[0].isApprox(R_start));
+}
+
+// The fall line of a ramp, modulo 90 degrees about gravity; none on a level table, a ramp under
+// 2 degrees, or ground sloping every way.
+TEST(PreOrientation, SlopeDirectionIsTheRampsFallLine) {
+  auto model = [](const Mesh& m) { return buildAreaModel(m, Eigen::Vector3d(0, 0, -1), 0.002, 0.0035, 0.0035); };
+  auto turned = [](Mesh m, double deg) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    std::vector<Eigen::Vector3d> v;
+    for (const auto& p : m.vertices) v.push_back(R * p);
+    std::vector<std::vector<int>> f;
+    for (const auto& t : m.triangles) f.push_back({t[0], t[1], t[2]});
+    return buildMesh(v, f, "turned");
+  };
+  // Tilted about x: the fall line runs along y, 90 = 0 degrees modulo 90; turned by 30 about z.
+  const auto along = areaSlopeDirection(model(scenes::plane(0.8, 0.8, 8.0)));
+  ASSERT_TRUE(along.has_value());
+  EXPECT_LT(std::min(*along, M_PI / 2 - *along), 1e-6);
+  const auto turned30 = areaSlopeDirection(model(turned(scenes::plane(0.8, 0.8, 8.0), 30.0)));
+  ASSERT_TRUE(turned30.has_value());
+  EXPECT_NEAR(*turned30, 30 * M_PI / 180, 1e-6);
+  EXPECT_FALSE(areaSlopeDirection(model(scenes::plane(0.8, 0.8, 1.0))).has_value());
+  EXPECT_FALSE(areaSlopeDirection(model(scenes::table())).has_value());
+  // A bowl-shaped hollow (ground sloping towards its centre from every side).
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::vector<int>> f;
+  const int n = 24;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = -0.4 + 0.8 * i / n, y = -0.4 + 0.8 * j / n;
+      v.emplace_back(x, y, 0.3 * (x * x + y * y));
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i;
+      f.push_back({a, a + 1, a + n + 2});
+      f.push_back({a, a + n + 2, a + n + 1});
+    }
+  EXPECT_FALSE(areaSlopeDirection(model(buildMesh(v, f, "hollow"))).has_value());
 }
 
 TEST(TiltAxis, LayoutsAndAxes) {

@@ -277,6 +277,37 @@ TEST(PhysicsValidator, CrackerBoxInDividedTrayBestCandidatesStayPut) {
   EXPECT_EQ(checked, 5);
 }
 
+// The YCB marker on an 8 degree ramp (under the friction angle, 11.3 degrees) whose fall line
+// runs across the marker's own long axis, default options: the three best stable candidates
+// lie along the fall line and stay put in Bullet. Started only
+// from its resting faces, held and principal-axis orientations, every candidate lay across the
+// ramp, and Bullet rolled each of them down it (30-49 degrees, 5-7 mm).
+TEST(PhysicsValidator, YcbMarkerOnARampLiesAlongItsFallLineAndStays) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh marker = loadMesh(validation_test::sharedData() + "/objects/marker_ycb040_1k.ply");
+  // Rising along x: its fall line runs across the marker's own long axis (y).
+  const double t = 8.0 * M_PI / 180;
+  const Mesh ramp = buildMesh({{-0.4, -0.4, -0.4 * std::tan(t)}, {0.4, -0.4, 0.4 * std::tan(t)},
+                               {0.4, 0.4, 0.4 * std::tan(t)}, {-0.4, 0.4, -0.4 * std::tan(t)}},
+                              {{0, 1, 2}, {0, 2, 3}}, "ramp");
+  PlannerConfig config;
+  config.threads = 2;
+  const PlanResult r = Planner().plan(marker, ramp, config);
+  PhysicsValidator v(marker, ramp, withFriction(config.friction));
+  const Eigen::Vector3d long_axis_O = marker.properties.k1();
+  int checked = 0;
+  for (const Candidate& c : r.candidates) {
+    if (!c.stable || checked == 3) continue;
+    ++checked;
+    const Eigen::Vector3d axis_W = c.X_WO.linear() * long_axis_O;
+    EXPECT_GT(std::abs(axis_W.x()), std::cos(15 * M_PI / 180)) << "candidate " << checked << " lies across the ramp: its long axis "
+                                                             << axis_W.transpose();
+    const PoseCheck k = v.check(c.X_WO);
+    EXPECT_TRUE(k.confirmed) << "candidate " << checked << ": moved " << k.moved_m << " m, turned " << k.turned_deg << " deg";
+  }
+  EXPECT_EQ(checked, 3);
+}
+
 // ---------------------------------------------------------------- verifyTopK
 
 // The cube on the built-in table, planned from the principal axis (any core: it rests on a face).

@@ -21,10 +21,15 @@ struct StartOrientation {
 // surface shares one direction (within 5 degrees, modulo 90) or there is hardly any.
 std::optional<double> areaWallDirection(const AreaModel& area);
 
+// Direction of the fall lines of the area's sloped up-facing surface (tilted 2 to 72 degrees)
+// about gravity, modulo 90 degrees, each face weighted by its area times its slope's sine;
+// empty as areaWallDirection (a level area, or slopes every way: terrain, a noisy scan).
+std::optional<double> areaSlopeDirection(const AreaModel& area);
+
 // The roots' orientations, likeliest first. kAuto: the resting faces (best tipping margin
 // first, each turned minimally from the held orientation), the held orientation, the principal
 // axis, and turns about d_vis that align the object's long horizontal side with the area's
-// walls and across them; orientations within 8 degrees of an earlier one are dropped.
+// walls and across them, and with its slopes' fall lines and across them; orientations within 8 degrees of an earlier one are dropped.
 // The other modes are the paper's (pre_orientation.h).
 std::vector<StartOrientation> startOrientations(const Mesh& object, const Eigen::Matrix3d& R_held_G,
                                                 const Eigen::Vector3d& d_vis_G,

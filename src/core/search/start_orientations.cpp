@@ -15,6 +15,8 @@ namespace {
 // Resting facets must hold against a tilt well beyond the release tilt.
 constexpr double kMinRestingTipDeg = 10.0;
 constexpr double kDistinctDeg = 8.0;
+// Up-facing surface tilted less than this is level: a round object does not roll off it.
+constexpr double kLevelDeg = 2.0;
 
 // Angle about z of the object's longest horizontal extent (2D principal axis of its vertices
 // in G) and its elongation (ratio of the two spreads).
@@ -45,37 +47,57 @@ Eigen::Matrix3d minimalTurn(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
 
 }  // namespace
 
-std::optional<double> areaWallDirection(const AreaModel& area) {
+namespace {
+
+// The dominant direction about gravity, modulo 90 degrees, of the horizontal part of the normals
+// of the area's triangles that `counts` selects, each weighted by its area times that part's
+// length; empty when they cover under 2 % of the area or no direction holds a third of them.
+template <typename Counts>
+std::optional<double> dominantDirection(const AreaModel& area, Counts counts) {
   // Directions modulo 90 degrees as angles 4 phi on a circle, so 89.9 and 0.1 degrees agree.
   constexpr int kBins = 18;  // 5 degrees each over [0, 90)
-  double hist[kBins] = {0}, total = 0, all = 0;
-  std::vector<std::pair<double, double>> walls;  // (4 phi, area)
+  double hist[kBins] = {0}, total = 0, all = 0, covered = 0;
+  std::vector<std::pair<double, double>> dirs;  // (4 phi, weight)
   for (size_t t = 0; t < area.triangles.size(); ++t) {
     const auto& tri = area.triangles[t];
     const V3 a = area.vertices[tri[0]], b = area.vertices[tri[1]], c = area.vertices[tri[2]];
     const double A = 0.5 * norm(cross(b - a, c - a));
     all += A;
     const V3 n = area.triangle_normals[t];
-    if (std::abs(n.z) > 0.3) continue;
+    if (!counts(n)) continue;
+    const double w = A * std::hypot(n.x, n.y);
     const double phi4 = std::fmod(4 * std::atan2(n.y, n.x) + 16 * M_PI, 2 * M_PI);
-    hist[std::min(kBins - 1, static_cast<int>(phi4 / (2 * M_PI) * kBins))] += A;
-    walls.emplace_back(phi4, A);
-    total += A;
+    hist[std::min(kBins - 1, static_cast<int>(phi4 / (2 * M_PI) * kBins))] += w;
+    dirs.emplace_back(phi4, w);
+    total += w;
+    covered += A;
   }
-  if (total < 0.02 * all || total <= 0) return std::nullopt;
+  if (covered < 0.02 * all || total <= 0) return std::nullopt;
   int best = 0;
   for (int i = 1; i < kBins; ++i)
     if (hist[i] + hist[(i + 1) % kBins] > hist[best] + hist[(best + 1) % kBins]) best = i;
   if (hist[best] + hist[(best + 1) % kBins] < total / 3) return std::nullopt;
-  // The peak's direction: the circular mean of the walls within 10 degrees (of phi) of it.
+  // The peak's direction: the circular mean of the directions within 10 degrees (of phi) of it.
   const double centre = (best + 1) * (2 * M_PI / kBins);
   double sx = 0, sy = 0;
-  for (const auto& [phi4, A] : walls)
+  for (const auto& [phi4, w] : dirs)
     if (std::cos(phi4 - centre) > std::cos(4 * 10 * M_PI / 180)) {
-      sx += A * std::cos(phi4);
-      sy += A * std::sin(phi4);
+      sx += w * std::cos(phi4);
+      sy += w * std::sin(phi4);
     }
   return std::fmod(std::atan2(sy, sx) + 2 * M_PI, 2 * M_PI) / 4;
+}
+
+}  // namespace
+
+std::optional<double> areaWallDirection(const AreaModel& area) {
+  return dominantDirection(area, [](const V3& n) { return std::abs(n.z) <= 0.3; });
+}
+
+std::optional<double> areaSlopeDirection(const AreaModel& area) {
+  const double level = std::cos(kLevelDeg * M_PI / 180);
+  // |n.z|: a scan's faces may be wound either way (the direction is modulo 90 degrees anyway).
+  return dominantDirection(area, [level](const V3& n) { return std::abs(n.z) > 0.3 && std::abs(n.z) < level; });
 }
 
 std::vector<StartOrientation> startOrientations(const Mesh& object, const Eigen::Matrix3d& R_held_G,
@@ -121,15 +143,18 @@ std::vector<StartOrientation> startOrientations(const Mesh& object, const Eigen:
   add(R_held_G, StartKind::kHeld);
   const auto pa = preOrientations(object.properties, R_held_G, d_vis_G, OrientationMode::kPrincipalAxis);
   add(pa.front(), StartKind::kPrincipalAxis);
-  // Turns about d_vis toward the area's walls: for the best resting face and the principal axis.
-  if (const auto wall = areaWallDirection(area)) {
-    std::vector<Eigen::Matrix3d> bases;
-    if (!resting.empty()) bases.push_back(resting.front());
-    bases.push_back(pa.front());
+  // Turns about d_vis toward the area's walls (slots, dividers) and along and across its
+  // slopes' fall lines (a long round object lies along a ramp, not across it, where it rolls):
+  // for the best resting face and the principal axis.
+  std::vector<Eigen::Matrix3d> bases;
+  if (!resting.empty()) bases.push_back(resting.front());
+  bases.push_back(pa.front());
+  for (const auto& dir : {areaWallDirection(area), areaSlopeDirection(area)}) {
+    if (!dir) continue;
     for (const auto& R : bases) {
       const auto [phi, ratio] = horizontalAxis(object, R);
       if (ratio < 1.3) continue;  // round in plan view: a turn changes nothing
-      for (double target : {*wall, *wall + M_PI / 2}) {
+      for (double target : {*dir, *dir + M_PI / 2}) {
         const Eigen::Matrix3d turn = Eigen::AngleAxisd(target - phi, -d_vis_G.normalized()).toRotationMatrix();
         add(turn * R, StartKind::kAreaTurn);
       }

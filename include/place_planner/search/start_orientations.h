@@ -29,7 +29,8 @@ std::optional<double> areaSlopeDirection(const AreaModel& area);
 // The roots' orientations, likeliest first. kAuto: the resting faces (best tipping margin
 // first, each turned minimally from the held orientation), the held orientation, the principal
 // axis, and turns about d_vis that align the object's long horizontal side with the area's
-// walls and across them, and with its slopes' fall lines and across them; orientations within 8 degrees of an earlier one are dropped.
+// walls and across them, and with its slopes' fall lines and across them; orientations within
+// 8 degrees of an earlier one are dropped.
 // The other modes are the paper's (pre_orientation.h).
 std::vector<StartOrientation> startOrientations(const Mesh& object, const Eigen::Matrix3d& R_held_G,
                                                 const Eigen::Vector3d& d_vis_G,

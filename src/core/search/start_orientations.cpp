@@ -45,10 +45,6 @@ Eigen::Matrix3d minimalTurn(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
   return Eigen::AngleAxisd(M_PI, axis.normalized()).toRotationMatrix();
 }
 
-}  // namespace
-
-namespace {
-
 // The dominant direction about gravity, modulo 90 degrees, of the horizontal part of the normals
 // of the area's triangles that `counts` selects, each weighted by its area times that part's
 // length; empty when they cover under 2 % of the area or no direction holds a third of them.

@@ -476,8 +476,8 @@ TEST(PlacePlannerCli, PlacementHangingIsChosenAndReported) {
   EXPECT_TRUE(contains(bad.out + bad.err, "--placement")) << bad.out << bad.err;
 }
 
-// The CPU is the normal case for `auto`: named once in the times block, no warning; -v says why.
-// backend auto is the CPU, GPU or not (doc/gpu.md, "Measured").
+// `auto` plans on the CPU, GPU or not (doc/gpu.md, "Measured"): named once in the times block,
+// no warning; -v says why.
 TEST(PlacePlannerCli, CpuBackendIsNamedOnceAndNotAWarning) {
   const CliRun r = cli(cubeOnTable({"--no-robust-check"}));
   EXPECT_EQ(r.code, 0) << r.err;

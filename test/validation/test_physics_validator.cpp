@@ -279,9 +279,9 @@ TEST(PhysicsValidator, CrackerBoxInDividedTrayBestCandidatesStayPut) {
 
 // The YCB marker on an 8 degree ramp (under the friction angle, 11.3 degrees) whose fall line
 // runs across the marker's own long axis, default options: the three best stable candidates
-// lie along the fall line and stay put in Bullet. Started only
-// from its resting faces, held and principal-axis orientations, every candidate lay across the
-// ramp, and Bullet rolled each of them down it (30-49 degrees, 5-7 mm).
+// lie along the fall line and stay put in Bullet. Started only from its resting faces, held and
+// principal-axis orientations, every candidate lay across the ramp, and Bullet rolled each of
+// them down it (30-49 degrees, 5-7 mm).
 TEST(PhysicsValidator, YcbMarkerOnARampLiesAlongItsFallLineAndStays) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
   const Mesh marker = loadMesh(validation_test::sharedData() + "/objects/marker_ycb040_1k.ply");

@@ -39,6 +39,9 @@ struct PhysicsCheck {
   bool stayed = false;    // moved < 1 cm and turned < 5 degrees after release
   double moved_m = 0.0;
   double turned_deg = 0.0;
+  // The candidate's place in the planner's ranking: a check that failed moves it behind the
+  // stable ones that did not (validation::verifyTopK), so the list's order is no longer it.
+  int planner_rank = -1;
 };
 
 // What carries a candidate: seen surface, or surface a scan never saw (model/completion.h).

@@ -561,7 +561,10 @@ VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerCo
   const auto t0 = Clock::now();
   VerifyStats s;
   std::vector<Candidate>& cands = result.candidates;
-  for (Candidate& c : cands) c.physics = PhysicsCheck();
+  for (size_t i = 0; i < cands.size(); ++i) {
+    cands[i].physics = PhysicsCheck();
+    cands[i].physics.planner_rank = static_cast<int>(i);
+  }
   // The best k stable candidates, in rank order.
   std::vector<size_t> picked;
   for (size_t i = 0; i < cands.size() && static_cast<int>(picked.size()) < k; ++i)

@@ -395,6 +395,10 @@ TEST(VerifyTopK, CubeTiltedOnACornerFallsAndMovesDownTheRanking) {
   EXPECT_TRUE(r.candidates[1].stable) << "the planner's verdict is kept";
   EXPECT_DOUBLE_EQ(r.candidates[2].quality, 0.2);
   EXPECT_FALSE(r.candidates[2].physics.checked);
+  // Each keeps its place in the planner's ranking.
+  EXPECT_EQ(r.candidates[0].physics.planner_rank, 1);
+  EXPECT_EQ(fell.planner_rank, 0);
+  EXPECT_EQ(r.candidates[2].physics.planner_rank, 2);
 }
 
 TEST(VerifyTopK, KLargerThanTheCandidatesChecksEveryStableOne) {

@@ -39,8 +39,8 @@ struct PhysicsCheck {
   bool stayed = false;    // moved < 1 cm and turned < 5 degrees after release
   double moved_m = 0.0;
   double turned_deg = 0.0;
-  // The candidate's place in the planner's ranking: a check that failed moves it behind the
-  // stable ones that did not (validation::verifyTopK), so the list's order is no longer it.
+  // The candidate's place in the planner's ranking (set by validation::verifyTopK, which moves a
+  // candidate that fell behind the stable ones that did not, so the list may differ from it).
   int planner_rank = -1;
 };
 

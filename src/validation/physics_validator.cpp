@@ -399,15 +399,20 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
 
   // Object: compound of convex pieces, body origin at c_O, axes of O.
   d.object_shape = std::make_unique<btCompoundShape>(true, static_cast<int>(object_O.triangles.size()));
-  // A (nearly) convex closed object is one hull: exact and much cheaper than pieces.
+  // A (nearly) convex closed object is one hull: exact and much cheaper than pieces. Not one
+  // with a loop: its hull fills the opening (a solid mug's handle), and a peg through it is
+  // then inside the object.
   std::vector<std::vector<Eigen::Vector3d>> pieces;
   d.convexity = meshConvexity(object_O);
-  if (d.convexity >= config.convex_volume_ratio) {
+  std::vector<Loop> loops;
+  const bool near_convex = d.convexity >= config.convex_volume_ratio;
+  if (near_convex || config.loop_sized_pieces) loops = findLoops(object_O);
+  if (near_convex && loops.empty()) {
     pieces.push_back(object_O.vertices);
   } else {
     ValidatorConfig pc = config;
     if (config.loop_sized_pieces)
-      for (const Loop& l : findLoops(object_O)) pc.piece_max_size = std::min(pc.piece_max_size, l.radius);
+      for (const Loop& l : loops) pc.piece_max_size = std::min(pc.piece_max_size, l.radius);
     pieces = makeConvexPieces(object_O, pc);
   }
   for (const auto& pts : pieces) {

@@ -46,8 +46,9 @@ struct ValidatorConfig {
   double world_scale = 10.0;
   // A closed object whose volume is at least this fraction of its convex hull's is simulated as
   // that one hull (boxes, bottles, markers: it fills only the cap's or neck's small concavity;
-  // fast). Measured: a standing YCB cracker box made of pieces walked 7 cm in 2 s, as its hull it
-  // stays (0.8 deg). 1.01 = always pieces.
+  // fast), unless it has a loop (the hull would fill the opening). Measured: a standing YCB
+  // cracker box made of pieces walked 7 cm in 2 s, as its hull it stays (0.8 deg). 1.01 = always
+  // pieces.
   double convex_volume_ratio = 0.85;
   double piece_thickness = 0.01;         // m, inward thickening of each piece (less in thin parts)
   int piece_max_triangles = 32;          // triangles per convex piece at most

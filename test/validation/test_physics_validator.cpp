@@ -103,6 +103,21 @@ TEST(PhysicsValidator, CylinderUprightIsConfirmed) {
   EXPECT_TRUE(r.confirmed) << "moved " << r.moved_m << " m, turned " << r.turned_deg << " deg";
 }
 
+// A solid mug (a closed cylinder, 10 cm across, and a C of 6 mm bars for a handle) fills over
+// 85 % of its convex hull, but the hull would also fill the handle's opening: a bar through the
+// opening, touching nothing, would then be inside the mug, and Bullet would throw the mug off
+// it (moved 18 mm). Standing on the table with the bar through its handle, it stays.
+TEST(PhysicsValidator, ASolidMugsHandleStaysOpen) {
+  using scenes::box;
+  // The opening: x 0.05-0.069, z -0.027-0.027 (the body's centre at the origin).
+  const Mesh mug = scenes::merge({scenes::cylinder(0.05, 0.1, 32), box(0.03, 0.006, 0.006, {0.06, 0, 0.03}),
+                                  box(0.03, 0.006, 0.006, {0.06, 0, -0.03}), box(0.006, 0.006, 0.066, {0.072, 0, 0})});
+  const Mesh area = scenes::merge({scenes::table(), box(0.006, 0.2, 0.006, {0.06, 0, 0.05})});
+  PhysicsValidator v(mug, area, withFriction(0.3));
+  const PoseCheck r = v.check(pose(Eigen::Matrix3d::Identity(), {0, 0, 0.05}));
+  EXPECT_TRUE(r.confirmed) << "moved " << r.moved_m << " m, turned " << r.turned_deg << " deg";
+}
+
 // Balanced on its bottom rim, tilted 30 deg: the centre of mass is 1 cm off the contact edge,
 // so it falls back (or over). Not a stable pose.
 TEST(PhysicsValidator, CylinderTiltedOnItsEdgeIsRejected) {

@@ -3,6 +3,7 @@
 // stream per backend (per plan). The area's model is uploaded once per build and kept on the
 // device beside the host cache (keyed by AreaModel::id); the object's per plan.
 #include <algorithm>
+#include <cstdlib>
 #include <list>
 #include <memory>
 #include <mutex>
@@ -69,6 +70,8 @@ void ensureStackLimit() {
   g_stack_limit_set = true;
 }
 
+constexpr int kSplitLevels = 5;
+
 class CudaDevice {
  public:
   CudaDevice(const ObjectModel& o, const AreaModel& a) {
@@ -91,6 +94,16 @@ class CudaDevice {
   size_t preferredBatch(size_t spheres) const {
     const size_t by_memory = (size_t(1) << 30) / (std::max<size_t>(spheres, 1) * sizeof(SphereContact));
     return std::clamp<size_t>(by_memory, 64, 8192);
+  }
+  // Each distance and tilt answer split into 2^levels work items over the subtrees of its BVHs
+  // (batched_steps.h): a step's few hundred poses are otherwise a few warps on the whole GPU.
+  // PLACE_PLANNER_CUDA_SPLIT_LEVELS (0-10) overrides it, to measure (doc/gpu.md).
+  int splitLevels() const {
+    static const int levels = [] {
+      const char* e = std::getenv("PLACE_PLANNER_CUDA_SPLIT_LEVELS");
+      return e ? std::clamp(std::atoi(e), 0, 10) : kSplitLevels;
+    }();
+    return levels;
   }
   const ObjectView& object() const { return obj_; }
   const AreaView& area() const { return area_->view; }

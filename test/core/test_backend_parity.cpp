@@ -8,6 +8,7 @@
 #include "place_planner/infra/backend.h"
 #include "place_planner/infra/cuda_backend.h"
 #include "place_planner/infra/mesh_io.h"
+#include "place_planner/kernels/batched_steps.h"
 #include "place_planner/planner.h"
 #include "test_helpers.h"
 
@@ -76,6 +77,13 @@ std::vector<std::pair<ContactKey, SphereContact>> sorted(const std::vector<Spher
 
 double capped(double v) { return std::min(v, 1e3); }
 
+struct Host {  // the host models, as the CPU backend reads them
+  template <typename T>
+  const T* operator()(const std::vector<T>& v) const {
+    return v.empty() ? nullptr : v.data();
+  }
+};
+
 }  // namespace
 
 TEST(BackendParity, QueriesHitOnTheCpu) {
@@ -97,6 +105,41 @@ TEST(BackendParity, QueriesHitOnTheCpu) {
     size_t finite = 0;
     for (size_t i = 0; i < a.size(); ++i) finite += a[i].ccw < kInf || a[i].cw < kInf || e[i].ccw < kInf || e[i].cw < kInf;
     EXPECT_GE(finite, a.size() / 2) << "rotations found no contact";
+  }
+}
+
+// The GPU splits each distance and tilt answer into 2^levels work items over subtrees of its
+// BVHs, met by an atomic minimum (batched_steps.h). Run here on the host, item by item, the
+// split answers are the whole ones, value by value, for every split the GPU may use.
+TEST(BackendParity, SplitWorkItemsGiveTheWholeAnswers) {
+  for (const Scene& s : scenesToCompare()) {
+    SCOPED_TRACE(s.name);
+    const ObjectModel om = buildObjectModel(s.object, 0.0015);
+    const AreaModel am = buildAreaModel(s.area, {0, 0, -1}, 0.002, 0.0035, 0.0035);
+    const TiltParams tp{0.002, 1e-6};
+    auto cpu = makeCpuBackend(om, am, tp, 2);
+    const Queries q = queriesFor(om, am, *cpu);
+    const ObjectView o = makeObjectView(om, Host{});
+    const AreaView a = makeAreaView(am, Host{});
+    auto run = [](size_t n, int levels, double* out, const auto& item) {
+      for (size_t i = 0; i < n; ++i) FillItem{out, kInf}(i);
+      for (size_t k = 0; k < (n << levels); ++k) item(k);
+    };
+    std::vector<double> t0(q.t.size()), v0(2 * q.r.size()), e0(2 * q.r.size());
+    run(t0.size(), 0, t0.data(), DistanceItem{o, a, q.t.data(), t0.data(), 0});
+    run(v0.size(), 0, v0.data(), RotationItem<true>{o, a, q.r.data(), v0.data(), tp, 0});
+    run(e0.size(), 0, e0.data(), RotationItem<false>{o, a, q.r.data(), e0.data(), tp, 0});
+    ASSERT_GT(std::count_if(t0.begin(), t0.end(), [](double x) { return x < kInf; }), 0);
+    for (const int levels : {1, 3, 5, 8}) {
+      SCOPED_TRACE("levels " + std::to_string(levels));
+      std::vector<double> t(t0.size()), v(v0.size()), e(e0.size());
+      run(t.size(), levels, t.data(), DistanceItem{o, a, q.t.data(), t.data(), levels});
+      run(v.size(), levels, v.data(), RotationItem<true>{o, a, q.r.data(), v.data(), tp, levels});
+      run(e.size(), levels, e.data(), RotationItem<false>{o, a, q.r.data(), e.data(), tp, levels});
+      for (size_t i = 0; i < t.size(); ++i) EXPECT_EQ(t[i], std::max(t0[i], 0.0)) << "distance " << i;
+      for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], v0[i]) << "vertex/surface tilt " << i;
+      for (size_t i = 0; i < e.size(); ++i) EXPECT_EQ(e[i], e0[i]) << "edge/edge tilt " << i;
+    }
   }
 }
 

@@ -7,6 +7,7 @@
 //   template <class T> const T* upload(int slot, const std::vector<T>& host);
 //   template <class T> void download(const T* dev, size_t n, T* host);
 //   size_t preferredBatch(size_t spheres_per_pose) const;
+//   int splitLevels() const;                                     // work items per answer: 2^levels
 //   ObjectView object() const; AreaView area() const;           // views in its memory
 //   void finish();                                               // waits, throws on a fault
 // Frames: poses X_GO (object O into the area's gravity frame G), as in backend.h.
@@ -57,15 +58,26 @@ AreaView makeAreaView(const AreaModel& a, Up&& up) {
 }
 
 // ------------------------------------------------------------------ work items
+// With `levels` > 0 each answer is split into 2^levels parts (subtreeRoot), one work item each,
+// item k = (answer << levels) | part, met by an atomic minimum in an answer filled with kInf
+// first (FillItem): a GPU runs a few hundred poses per step, too few threads alone. 0: one item
+// per answer (the CPU's workers are few; a whole tree prunes best).
 struct DistanceItem {  // V-A: one translation query
   ObjectView o;
   AreaView a;
   const TranslationQuery* q;
   double* t;
-  PP_HD void operator()(size_t i) const { t[i] = firstContactDistance(o, a, q[i].X_GO, q[i].d, q[i].tmax); }
+  int levels = 0;
+  PP_HD void operator()(size_t k) const {
+    const size_t i = k >> levels;
+    const int part = static_cast<int>(k & ((size_t{1} << levels) - 1));
+    const double h = firstContactDistance(o, a, q[i].X_GO, q[i].d, q[i].tmax, part, levels);
+    if (levels == 0) t[i] = h;
+    else if (h < kInf) atomicMinNonNegative(t + i, maxv(h, 0.0));
+  }
 };
 
-// V-C.2: one (pose, direction) pair, k = 2 i (ccw) or 2 i + 1 (cw).
+// V-C.2: one (pose, direction) pair, j = 2 i (ccw) or 2 i + 1 (cw); split as DistanceItem.
 template <bool kVertex>
 struct RotationItem {
   ObjectView o;
@@ -73,13 +85,23 @@ struct RotationItem {
   const RotationQuery* q;
   double* out;
   TiltParams tp;
+  int levels = 0;
   PP_HD void operator()(size_t k) const {
-    const size_t i = k / 2;
-    const int sigma = k % 2 ? -1 : 1;
+    const size_t j = k >> levels, i = j / 2;
+    const int part = static_cast<int>(k & ((size_t{1} << levels) - 1));
+    const int sigma = j % 2 ? -1 : 1;
     const double limit = sigma > 0 ? q[i].limit_ccw : q[i].limit_cw;
-    out[k] = kVertex ? vertexSurfaceAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit)
-                     : edgeEdgeAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit);
+    const double th = kVertex ? vertexSurfaceAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit, part, levels)
+                              : edgeEdgeAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit, part, levels);
+    if (levels == 0) out[j] = th;
+    else if (th < kInf) atomicMinNonNegative(out + j, th);
   }
+};
+
+struct FillItem {  // the answers an atomic minimum meets in
+  double* t;
+  double value;
+  PP_HD void operator()(size_t i) const { t[i] = value; }
 };
 
 // V-B: one pose; its object spheres culled through the height grid (forEachSphereNearArea),
@@ -133,7 +155,9 @@ class BatchedBackend : public Backend {
     t.assign(q.size(), kInf);
     if (q.empty()) return;
     double* dt = dev_.template scratch<double>(kOut, q.size());
-    dev_.parallelFor(q.size(), DistanceItem{dev_.object(), dev_.area(), dev_.upload(kQueries, q), dt});
+    const int levels = dev_.splitLevels();
+    if (levels > 0) dev_.parallelFor(q.size(), FillItem{dt, kInf});
+    dev_.parallelFor(q.size() << levels, DistanceItem{dev_.object(), dev_.area(), dev_.upload(kQueries, q), dt, levels});
     dev_.finish();
     dev_.download(dt, q.size(), t.data());
   }
@@ -172,7 +196,10 @@ class BatchedBackend : public Backend {
     a.assign(q.size(), AnglePair{});
     if (q.empty()) return;
     double* out = dev_.template scratch<double>(kOut, 2 * q.size());
-    dev_.parallelFor(2 * q.size(), RotationItem<kVertex>{dev_.object(), dev_.area(), dev_.upload(kQueries, q), out, tp_});
+    const int levels = dev_.splitLevels();
+    if (levels > 0) dev_.parallelFor(2 * q.size(), FillItem{out, kInf});
+    dev_.parallelFor((2 * q.size()) << levels,
+                     RotationItem<kVertex>{dev_.object(), dev_.area(), dev_.upload(kQueries, q), out, tp_, levels});
     dev_.finish();
     std::vector<double> h(2 * q.size());
     dev_.download(out, h.size(), h.data());

@@ -59,8 +59,8 @@ struct FixedReach {
 template <typename BoxA, typename Prep, typename Leaf, typename NearerA = AnyOrder, typename NearerB = AnyOrder,
           typename Reach = FixedReach>
 PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& prep, Leaf&& leaf,
-                        NearerA nearerA = {}, NearerB nearerB = {}, Reach reach = {}) {
-  if (A.num_nodes == 0 || B.num_nodes == 0) return;
+                        NearerA nearerA = {}, NearerB nearerB = {}, Reach reach = {}, int rootA = 0) {
+  if (A.num_nodes == 0 || B.num_nodes == 0 || rootA < 0) return;
   // Each entry carries A's mapped box, so a node of A is mapped once per split, not once per
   // node of B it meets. Pairs are pushed only when their boxes overlap.
   struct Pair {
@@ -72,9 +72,9 @@ PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& 
   Pair stack[kPairStack];
   int top = 0;
   {
-    const Aabb root = boxA(A.nodes[0]);
+    const Aabb root = boxA(A.nodes[rootA]);
     if (!aabbOverlap(root, B.nodes[0].box)) return;
-    stack[top++] = Pair{0, 0, root, reach()};
+    stack[top++] = Pair{rootA, 0, root, reach()};
   }
   while (top > 0) {
     Pair p = stack[--top];
@@ -128,6 +128,34 @@ PP_HD void dualTraverse(const BvhView& A, const BvhView& B, BoxA&& boxA, Prep&& 
   }
 }
 
+// One work item per part of a query (the GPU's threads, Section VII-C): part p of 2^levels
+// walks the subtree of A reached from its root by p's bits, most significant first (0: left),
+// so the parts cover A's primitives once. A leaf met early is walked by the part whose
+// remaining bits are zero; the others get -1 (nothing). levels = 0: the whole tree.
+PP_HD int subtreeRoot(const BvhView& b, int part, int levels) {
+  if (b.num_nodes == 0) return -1;
+  int node = 0;
+  for (int l = levels - 1; l >= 0; --l) {
+    const bool right = (part >> l) & 1;
+    if (b.nodes[node].left < 0) return (part & ((1 << (l + 1)) - 1)) == 0 ? node : -1;
+    node = right ? b.nodes[node].right : b.nodes[node].left;
+  }
+  return node;
+}
+
+// *p = min(*p, v) for v >= 0, atomically: a query's parts (subtreeRoot) meet in one answer.
+// Non-negative doubles order as their bit patterns do.
+PP_HD void atomicMinNonNegative(double* p, double v) {
+#ifdef __CUDA_ARCH__
+  atomicMin(reinterpret_cast<unsigned long long*>(p), static_cast<unsigned long long>(__double_as_longlong(v)));
+#else
+  double cur;
+  __atomic_load(p, &cur, __ATOMIC_RELAXED);
+  while (v < cur && !__atomic_compare_exchange(p, &cur, &v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+  }
+#endif
+}
+
 PP_HD Aabb segmentBox(V3 a, V3 b) {
   Aabb s = aabbEmpty();
   aabbAdd(s, a);
@@ -140,7 +168,7 @@ PP_HD Aabb segmentBox(V3 a, V3 b) {
 // area: object vertices against area triangles, area vertices against object triangles, and
 // object edges against area edges. kInf when nothing is hit within tmax.
 PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, const Rigid& X_GO,
-                                  V3 d, double tmax) {
+                                  V3 d, double tmax, int part = 0, int levels = 0) {
   double best = tmax;
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
@@ -154,7 +182,7 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
     const int* tri = am.triangles + 3 * t;
     const double h = rayTriangle(v, d, am.vertices[tri[0]], am.vertices[tri[1]], am.vertices[tri[2]]);
     if (h < best) best = h;
-  }, ahead(d), ahead(-d), reach);
+  }, ahead(d), ahead(-d), reach, subtreeRoot(om.vertex_bvh, part, levels));
   // Object edges against area edges.
   auto posedEdge = [&](int ei) {
     const int* e = om.edges + 2 * ei;
@@ -167,7 +195,7 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
     if (!aabbOverlap(sweepBox(segmentBox(p0, p1), d, best), segmentBox(q0, q1))) return;
     const double h = edgeEdgeTranslation(p0, p1, q0, q1, d);
     if (h < best) best = h;
-  }, ahead(d), ahead(-d), reach);
+  }, ahead(d), ahead(-d), reach, subtreeRoot(om.edge_bvh, part, levels));
   // Area vertices moving by -d against the object's triangles, in O.
   const V3 dir_O = -rotateInv(X_GO, d);
   auto swept_area = [&](const BvhNode& n) {
@@ -178,7 +206,7 @@ PP_HD double firstContactDistance(const ObjectView& obj, const AreaView& area, c
     const int* tri = om.triangles + 3 * t;
     const double h = rayTriangle(w, dir_O, om.vertices[tri[0]], om.vertices[tri[1]], om.vertices[tri[2]]);
     if (h < best) best = h;
-  }, ahead(dir_O), ahead(-dir_O), reach);
+  }, ahead(dir_O), ahead(-dir_O), reach, subtreeRoot(am.vertex_bvh, part, levels));
   return best < tmax ? best : kInf;
 }
 
@@ -227,7 +255,7 @@ struct EdgeArc {
 // area vertex onto an object triangle. kInf when none below `limit`.
 PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, const Rigid& X_GO,
                                 V3 s_A, V3 d_A, int sigma, const TiltParams& tp,
-                                double limit = kInf) {
+                                double limit = kInf, int part = 0, int levels = 0) {
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
   double best = limit;
@@ -273,7 +301,8 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
           const double before = best;
           for (int j = 0; j < m; ++j) accept(out[j], sigma, v, am.triangle_normals[t], A, s_A, d_A);
           if (best < before) win = window(1);
-        });
+        },
+        AnyOrder{}, AnyOrder{}, FixedReach{}, subtreeRoot(om.vertex_bvh, part, levels));
     if (best <= angleWindowStart(k)) break;
     AngleWindow win_area = window(-1);
     dualTraverse(
@@ -295,7 +324,8 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
           const double before = best;
           for (int j = 0; j < m; ++j) accept(out[j], -sigma, w, om.triangle_normals[t], A, s_O, d_O);
           if (best < before) win_area = window(-1);
-        });
+        },
+        AnyOrder{}, AnyOrder{}, FixedReach{}, subtreeRoot(am.vertex_bvh, part, levels));
   }
   return best < limit ? best : kInf;
 }
@@ -304,7 +334,8 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
 // brings an object edge onto an area edge (surfaces of revolution, Table I). kInf when none
 // below `limit`.
 PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Rigid& X_GO, V3 s_A,
-                           V3 d_A, int sigma, const TiltParams& tp, double limit = kInf) {
+                           V3 d_A, int sigma, const TiltParams& tp, double limit = kInf, int part = 0,
+                           int levels = 0) {
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
   double best = limit;
@@ -337,7 +368,8 @@ PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Ri
             if (th > tp.min_angle && th < best && th <= max_angle) best = th;
           }
           if (best < before) win = window();
-        });
+        },
+        AnyOrder{}, AnyOrder{}, FixedReach{}, subtreeRoot(om.edge_bvh, part, levels));
   }
   return best < limit ? best : kInf;
 }

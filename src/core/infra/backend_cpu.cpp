@@ -31,6 +31,8 @@ class CpuDevice {
     const size_t by_memory = (size_t(1) << 28) / (std::max<size_t>(spheres, 1) * sizeof(SphereContact));
     return std::max<size_t>(16, std::min<size_t>(32 * resolveThreads(threads_), by_memory));
   }
+  // One work item per answer: a few workers, and a whole tree prunes best (batched_steps.h).
+  int splitLevels() const { return 0; }
   const ObjectView& object() const { return obj_; }
   const AreaView& area() const { return area_; }
   template <typename F>

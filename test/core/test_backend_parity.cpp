@@ -109,8 +109,9 @@ TEST(BackendParity, QueriesHitOnTheCpu) {
 }
 
 // The GPU splits each distance and tilt answer into 2^levels work items over subtrees of its
-// BVHs, met by an atomic minimum (batched_steps.h). Run here on the host, item by item, the
-// split answers are the whole ones, value by value, for every split the GPU may use.
+// BVHs, met by an atomic minimum, the tilts one angle window per launch (batched_steps.h). Run
+// here on the host, item by item, the split answers are the whole ones, value by value, for
+// every split the GPU may use.
 TEST(BackendParity, SplitWorkItemsGiveTheWholeAnswers) {
   for (const Scene& s : scenesToCompare()) {
     SCOPED_TRACE(s.name);
@@ -125,6 +126,14 @@ TEST(BackendParity, SplitWorkItemsGiveTheWholeAnswers) {
       for (size_t i = 0; i < n; ++i) FillItem{out, kInf}(i);
       for (size_t k = 0; k < (n << levels); ++k) item(k);
     };
+    // As the launcher runs a split tilt: one angle window after the other.
+    auto tilts = [&](size_t n, int levels, double* out, auto item) {
+      for (size_t i = 0; i < n; ++i) FillItem{out, kInf}(i);
+      for (int w = 0; w < kNumAngleWindows; ++w) {
+        item.window = w;
+        for (size_t k = 0; k < (n << levels); ++k) item(k);
+      }
+    };
     std::vector<double> t0(q.t.size()), v0(2 * q.r.size()), e0(2 * q.r.size());
     run(t0.size(), 0, t0.data(), DistanceItem{o, a, q.t.data(), t0.data(), 0});
     run(v0.size(), 0, v0.data(), RotationItem<true>{o, a, q.r.data(), v0.data(), tp, 0});
@@ -134,11 +143,30 @@ TEST(BackendParity, SplitWorkItemsGiveTheWholeAnswers) {
       SCOPED_TRACE("levels " + std::to_string(levels));
       std::vector<double> t(t0.size()), v(v0.size()), e(e0.size());
       run(t.size(), levels, t.data(), DistanceItem{o, a, q.t.data(), t.data(), levels});
-      run(v.size(), levels, v.data(), RotationItem<true>{o, a, q.r.data(), v.data(), tp, levels});
-      run(e.size(), levels, e.data(), RotationItem<false>{o, a, q.r.data(), e.data(), tp, levels});
+      tilts(v.size(), levels, v.data(), RotationItem<true>{o, a, q.r.data(), v.data(), tp, levels});
+      tilts(e.size(), levels, e.data(), RotationItem<false>{o, a, q.r.data(), e.data(), tp, levels});
       for (size_t i = 0; i < t.size(); ++i) EXPECT_EQ(t[i], std::max(t0[i], 0.0)) << "distance " << i;
       for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], v0[i]) << "vertex/surface tilt " << i;
       for (size_t i = 0; i < e.size(); ++i) EXPECT_EQ(e[i], e0[i]) << "edge/edge tilt " << i;
+      // Contacts: each pose's, part after part, are the whole walk's, in the same order.
+      const int cap = o.mesh.num_spheres;
+      const size_t items = q.contact.size() << levels;
+      std::vector<SphereContact> c0(q.contact.size() * cap), c(q.contact.size() * cap);
+      std::vector<int> n0(q.contact.size()), n(items), first(items);
+      const ContactItem whole{o, a, q.contact.data(), c0.data(), n0.data(), cap};
+      const ContactItem split{o, a, q.contact.data(), c.data(), n.data(), cap, levels, first.data()};
+      for (size_t i = 0; i < q.contact.size(); ++i) whole(i);
+      for (size_t k = 0; k < items; ++k) split(k);
+      size_t total = 0;
+      for (size_t i = 0; i < q.contact.size(); ++i) {
+        std::vector<V3> got;
+        for (size_t k = i << levels; k < (i + 1) << levels; ++k)
+          for (int m = 0; m < n[k]; ++m) got.push_back(c[i * cap + first[k] + m].p);
+        ASSERT_EQ(got.size(), static_cast<size_t>(n0[i])) << "contacts of pose " << i;
+        for (int m = 0; m < n0[i]; ++m) EXPECT_EQ(norm(got[m] - c0[i * cap + m].p), 0.0) << "pose " << i;
+        total += got.size();
+      }
+      EXPECT_GT(total, 0u);
     }
   }
 }

@@ -77,7 +77,9 @@ struct DistanceItem {  // V-A: one translation query
   }
 };
 
-// V-C.2: one (pose, direction) pair, j = 2 i (ccw) or 2 i + 1 (cw); split as DistanceItem.
+// V-C.2: one (pose, direction) pair, j = 2 i (ccw) or 2 i + 1 (cw); split as DistanceItem, and
+// then one angle window per launch (`window`), skipped where an earlier one found the contact:
+// the whole tree stops at the first window with a hit, and a part alone would search them all.
 template <bool kVertex>
 struct RotationItem {
   ObjectView o;
@@ -86,13 +88,15 @@ struct RotationItem {
   double* out;
   TiltParams tp;
   int levels = 0;
+  int window = -1;  // -1: every window
   PP_HD void operator()(size_t k) const {
     const size_t j = k >> levels, i = j / 2;
     const int part = static_cast<int>(k & ((size_t{1} << levels) - 1));
+    if (window > 0 && out[j] <= angleWindowStart(window)) return;
     const int sigma = j % 2 ? -1 : 1;
     const double limit = sigma > 0 ? q[i].limit_ccw : q[i].limit_cw;
-    const double th = kVertex ? vertexSurfaceAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit, part, levels)
-                              : edgeEdgeAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit, part, levels);
+    const double th = kVertex ? vertexSurfaceAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit, part, levels, window)
+                              : edgeEdgeAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit, part, levels, window);
     if (levels == 0) out[j] = th;
     else if (th < kInf) atomicMinNonNegative(out + j, th);
   }
@@ -106,6 +110,8 @@ struct FillItem {  // the answers an atomic minimum meets in
 
 // V-B: one pose; its object spheres culled through the height grid (forEachSphereNearArea),
 // the contacts in sphere order into the pose's slots c[i * capacity ...], their number in n[i].
+// Split (levels > 0): item k = (i << levels) | part walks one subtree of the sphere tree and
+// writes from the slot where the subtree's spheres start (first[k]); n[k] counts its contacts.
 struct ContactItem {
   ObjectView o;
   AreaView a;
@@ -113,28 +119,38 @@ struct ContactItem {
   SphereContact* c;
   int* n;
   int capacity;
-  PP_HD void operator()(size_t i) const {
+  int levels = 0;
+  int* first = nullptr;  // per item: its first slot (levels > 0)
+  PP_HD void operator()(size_t k) const {
+    const size_t i = k >> levels;
+    const int root = subtreeRoot(o.mesh.sphere_bvh, static_cast<int>(k & ((size_t{1} << levels) - 1)), levels);
+    const int start = levels > 0 && root >= 0 ? subtreeFirst(o.mesh.sphere_bvh, root) : 0;
+    if (levels > 0) first[k] = start;
     const Rigid T = X[i];
     const V3 com = apply(T, o.com);
     int count = 0;
-    SphereContact* out = c + i * static_cast<size_t>(capacity);
+    SphereContact* out = c + i * static_cast<size_t>(capacity) + start;
     forEachSphereNearArea(o, a, T, [&](int s) {
       const SphereContact sc = sphereContact(a, apply(T, o.mesh.sphere_centres[s]), rotate(T, o.mesh.sphere_normals[s]), com);
-      if (sc.valid && count < capacity) out[count++] = sc;
-    });
-    n[i] = count;
+      if (sc.valid && start + count < capacity) out[count++] = sc;
+    }, root);
+    n[k] = count;
   }
 };
 
-// Packs the poses' contacts (n[i] of them in slots of `capacity`) at offsets off[i].
+// Packs the items' contacts (n[k] of them from slot first[k] of their pose's `capacity`) at
+// offsets off[k].
 struct CompactItem {
   const SphereContact* c;
   const int* n;
   const size_t* off;
   SphereContact* packed;
   int capacity;
-  PP_HD void operator()(size_t i) const {
-    for (int k = 0; k < n[i]; ++k) packed[off[i] + k] = c[i * static_cast<size_t>(capacity) + k];
+  int levels = 0;
+  const int* first = nullptr;
+  PP_HD void operator()(size_t k) const {
+    const SphereContact* from = c + (k >> levels) * static_cast<size_t>(capacity) + (levels > 0 ? first[k] : 0);
+    for (int m = 0; m < n[k]; ++m) packed[off[k] + m] = from[m];
   }
 };
 
@@ -171,35 +187,44 @@ class BatchedBackend : public Backend {
     out.assign(X.size(), {});
     const int cap = dev_.object().mesh.num_spheres;
     if (X.empty() || cap == 0) return;
+    const int levels = dev_.splitLevels();
+    const size_t items = X.size() << levels;
     SphereContact* dc = dev_.template scratch<SphereContact>(kContacts, X.size() * cap);
-    int* dn = dev_.template scratch<int>(kCounts, X.size());
-    dev_.parallelFor(X.size(), ContactItem{dev_.object(), dev_.area(), dev_.upload(kQueries, X), dc, dn, cap});
+    int* dn = dev_.template scratch<int>(kCounts, items);
+    int* dfirst = levels > 0 ? dev_.template scratch<int>(kFirsts, items) : nullptr;
+    dev_.parallelFor(items, ContactItem{dev_.object(), dev_.area(), dev_.upload(kQueries, X), dc, dn, cap, levels, dfirst});
     dev_.finish();
-    std::vector<int> n(X.size());
-    dev_.download(dn, X.size(), n.data());
-    // One download: the contacts packed pose after pose.
-    std::vector<size_t> off(X.size() + 1, 0);
-    for (size_t i = 0; i < X.size(); ++i) off[i + 1] = off[i] + n[i];
+    std::vector<int> n(items);
+    dev_.download(dn, items, n.data());
+    // One download: the contacts packed item after item (a pose's parts in sphere order).
+    std::vector<size_t> off(items + 1, 0);
+    for (size_t k = 0; k < items; ++k) off[k + 1] = off[k] + n[k];
     if (off.back() == 0) return;
     SphereContact* packed = dev_.template scratch<SphereContact>(kPacked, off.back());
-    dev_.parallelFor(X.size(), CompactItem{dc, dn, dev_.upload(kOffsets, off), packed, cap});
+    dev_.parallelFor(items, CompactItem{dc, dn, dev_.upload(kOffsets, off), packed, cap, levels, dfirst});
     dev_.finish();
     std::vector<SphereContact> all(off.back());
     dev_.download(packed, all.size(), all.data());
-    for (size_t i = 0; i < X.size(); ++i) out[i].assign(all.begin() + off[i], all.begin() + off[i + 1]);
+    for (size_t i = 0; i < X.size(); ++i)
+      out[i].assign(all.begin() + off[i << levels], all.begin() + off[(i + 1) << levels]);
   }
 
  private:
-  enum Slot { kQueries, kOut, kContacts, kCounts, kPacked, kOffsets };
+  enum Slot { kQueries, kOut, kContacts, kCounts, kPacked, kOffsets, kFirsts };
   template <bool kVertex>
   void rotation(const std::vector<RotationQuery>& q, std::vector<AnglePair>& a) {
     a.assign(q.size(), AnglePair{});
     if (q.empty()) return;
     double* out = dev_.template scratch<double>(kOut, 2 * q.size());
     const int levels = dev_.splitLevels();
-    if (levels > 0) dev_.parallelFor(2 * q.size(), FillItem{out, kInf});
-    dev_.parallelFor((2 * q.size()) << levels,
-                     RotationItem<kVertex>{dev_.object(), dev_.area(), dev_.upload(kQueries, q), out, tp_, levels});
+    const RotationQuery* dq = dev_.upload(kQueries, q);
+    if (levels == 0) {
+      dev_.parallelFor(2 * q.size(), RotationItem<kVertex>{dev_.object(), dev_.area(), dq, out, tp_});
+    } else {
+      dev_.parallelFor(2 * q.size(), FillItem{out, kInf});
+      for (int w = 0; w < kNumAngleWindows; ++w)
+        dev_.parallelFor((2 * q.size()) << levels, RotationItem<kVertex>{dev_.object(), dev_.area(), dq, out, tp_, levels, w});
+    }
     dev_.finish();
     std::vector<double> h(2 * q.size());
     dev_.download(out, h.size(), h.data());

@@ -143,6 +143,13 @@ PP_HD int subtreeRoot(const BvhView& b, int part, int levels) {
   return node;
 }
 
+// Where a subtree's primitives start in the tree's order (a subtree's leaves hold one range of
+// it, left to right).
+PP_HD int subtreeFirst(const BvhView& b, int node) {
+  while (b.nodes[node].left >= 0) node = b.nodes[node].left;
+  return b.nodes[node].first;
+}
+
 // *p = min(*p, v) for v >= 0, atomically: a query's parts (subtreeRoot) meet in one answer.
 // Non-negative doubles order as their bit patterns do.
 PP_HD void atomicMinNonNegative(double* p, double v) {
@@ -223,6 +230,11 @@ PP_HD double angleWindowEnd(int k) {
 }
 PP_HD double angleWindowStart(int k) { return k == 0 ? 0.0 : angleWindowEnd(k - 1); }
 
+// The windows a tilt searches: all (window < 0) or one (a split answer searches them one launch
+// at a time, so that a hit in an earlier one still ends it: batched_steps.h).
+PP_HD int firstWindow(int window) { return window < 0 ? 0 : window; }
+PP_HD int endWindow(int window) { return window < 0 ? kNumAngleWindows : window + 1; }
+
 struct TiltParams {
   double min_angle;  // angles at or below are the current contact, not a new one
   double tol;        // inside-patch tolerance, m
@@ -255,7 +267,7 @@ struct EdgeArc {
 // area vertex onto an object triangle. kInf when none below `limit`.
 PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, const Rigid& X_GO,
                                 V3 s_A, V3 d_A, int sigma, const TiltParams& tp,
-                                double limit = kInf, int part = 0, int levels = 0) {
+                                double limit = kInf, int part = 0, int levels = 0, int window = -1) {
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
   double best = limit;
@@ -275,7 +287,7 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
     }
     best = th;
   };
-  for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
+  for (int k = firstWindow(window); k < endWindow(window) && best > angleWindowStart(k); ++k) {
     // The window ends at the best angle so far: arcs past it cannot give a smaller one.
     // It also shrinks with every nearer hit, so the arcs of the nodes met after it are shorter.
     const double a0 = sigma * angleWindowStart(k);
@@ -335,13 +347,13 @@ PP_HD double vertexSurfaceAngle(const ObjectView& obj, const AreaView& area, con
 // below `limit`.
 PP_HD double edgeEdgeAngle(const ObjectView& obj, const AreaView& area, const Rigid& X_GO, V3 s_A,
                            V3 d_A, int sigma, const TiltParams& tp, double limit = kInf, int part = 0,
-                           int levels = 0) {
+                           int levels = 0, int window = -1) {
   const MeshView& om = obj.mesh;
   const MeshView& am = area.mesh;
   double best = limit;
   const AxisFrame frame = axisFrame(s_A, d_A);
   const double max_angle = angleWindowEnd(kNumAngleWindows - 1);
-  for (int k = 0; k < kNumAngleWindows && best > angleWindowStart(k); ++k) {
+  for (int k = firstWindow(window); k < endWindow(window) && best > angleWindowStart(k); ++k) {
     // The window ends at the best angle so far, and shrinks with every nearer hit.
     auto window = [&] { return angleWindow(sigma * angleWindowStart(k), sigma * minv(angleWindowEnd(k), best)); };
     AngleWindow win = window();
@@ -483,13 +495,15 @@ PP_HD bool gridMayCollide(const GridView& g, const Aabb& b) {
 
 // Calls f(sphere index) for the object spheres whose BVH leaf, posed, reaches below the height
 // grid (gridMayCollide), in increasing index order within each leaf.
+// `root`: the subtree walked (subtreeRoot; 0: the whole tree, -1: none).
 template <typename F>
-PP_HD void forEachSphereNearArea(const ObjectView& obj, const AreaView& area, const Rigid& X_GO, F&& f) {
+PP_HD void forEachSphereNearArea(const ObjectView& obj, const AreaView& area, const Rigid& X_GO, F&& f,
+                                 int root = 0) {
   const BvhView& b = obj.mesh.sphere_bvh;
-  if (b.num_nodes == 0) return;
+  if (b.num_nodes == 0 || root < 0) return;
   int stack[kBvhStack];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = root;
   while (top > 0) {
     const BvhNode& n = b.nodes[stack[--top]];
     if (!gridMayCollide(area.grid, transformBox(X_GO, n.box))) continue;

@@ -70,7 +70,9 @@ void ensureStackLimit() {
   g_stack_limit_set = true;
 }
 
-constexpr int kSplitLevels = 5;
+// Measured on an H200 (books_stack, 1k mug, cold; doc/gpu.md): distance and tilts fastest at
+// 11-12 levels, contact points at 10 (their slots and counts grow with the parts).
+constexpr int kSplitLevels = 11;
 
 class CudaDevice {
  public:
@@ -97,11 +99,12 @@ class CudaDevice {
   }
   // Each distance and tilt answer split into 2^levels work items over the subtrees of its BVHs
   // (batched_steps.h): a step's few hundred poses are otherwise a few warps on the whole GPU.
-  // PLACE_PLANNER_CUDA_SPLIT_LEVELS (0-10) overrides it, to measure (doc/gpu.md).
+  // PLACE_PLANNER_CUDA_SPLIT_LEVELS (0-14) overrides it, to measure (doc/gpu.md).
+  int contactSplitLevels() const { return std::max(0, splitLevels() - 1); }
   int splitLevels() const {
     static const int levels = [] {
       const char* e = std::getenv("PLACE_PLANNER_CUDA_SPLIT_LEVELS");
-      return e ? std::clamp(std::atoi(e), 0, 10) : kSplitLevels;
+      return e ? std::clamp(std::atoi(e), 0, 14) : kSplitLevels;
     }();
     return levels;
   }

@@ -81,7 +81,7 @@ struct PlannerConfig {
   double min_quality = 0.0;                  // candidates below are dropped
   double merge_distance = 0.005;             // m, poses closer than this ...
   double merge_angle_deg = 3.0;              // ... and this are one candidate
-  BackendKind backend = BackendKind::kAuto;  // kAuto: the CPU (faster today, doc/gpu.md); kCuda: the GPU
+  BackendKind backend = BackendKind::kAuto;  // kAuto: CUDA where a GPU answers, else the CPU (doc/gpu.md)
   // Bounded work (work_limits.h), each checked before the work it bounds. Generous: the
   // paper's workload is 1k triangles, 140 floor points, ~30k tree nodes, ~20 MB of models.
   int max_triangles = 300000;                // per mesh; a larger one is decimated (a warning says so)

@@ -282,7 +282,7 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
     throw std::runtime_error(std::string("planner failed: ") + e.what());
   }
   answer->planned = true;
-  // Which backend `auto` chose, and why the CPU: said once in the log, not as a warning.
+  // Which backend `auto` chose, and why: said once in the log, not as a warning.
   if (!plan.stats.backend_note.empty()) ROS_INFO_ONCE("place_planner: %s", plan.stats.backend_note.c_str());
   placed_.has_last_plan = true;
   placed_.last_object_O = prepared.object_O;

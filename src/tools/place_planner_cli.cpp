@@ -49,7 +49,7 @@ const char* kFooter =
     "binder_stack, mug, plate, pen, cube).\n"
     "--gravity auto: against the normal of the area's largest flat region (a scan in its camera\n"
     "frame). --backend gpu is the same as cuda: an error (exit 2) when no CUDA device is usable;\n"
-    "auto plans on the CPU.\n"
+    "auto plans on CUDA where a GPU answers, else on the CPU.\n"
     "--verify K: simulate the best K stable candidates in Bullet (released 2 mm above the pose;\n"
     "stayed = moved < 1 cm, turned < 5 deg) within what is left of --budget-ms; one that falls is\n"
     "moved behind the other stable candidates.\n"
@@ -460,7 +460,7 @@ int main(int argc, char** argv) {
   const std::map<std::string, BackendKind> backends = {
       {"auto", BackendKind::kAuto}, {"cpu", BackendKind::kCpu}, {"cuda", BackendKind::kCuda}, {"gpu", BackendKind::kCuda}};
   std::string backend_name = "auto";
-  app.add_option("--backend", backend_name, "auto: the CPU (faster than the CUDA kernels as measured, doc/gpu.md); cuda: the kernels; gpu = cuda")
+  app.add_option("--backend", backend_name, "auto: CUDA where a GPU answers, else the CPU; cuda: the GPU or an error; gpu = cuda")
       ->check(CLI::IsMember(backends))
       ->capture_default_str()
       ->type_name("NAME");

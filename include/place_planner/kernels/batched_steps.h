@@ -8,6 +8,7 @@
 //   template <class T> void download(const T* dev, size_t n, T* host);
 //   size_t preferredBatch(size_t spheres_per_pose) const;
 //   int splitLevels() const;                                     // work items per answer: 2^levels
+//   int contactSplitLevels() const;                              // the same for contact points
 //   ObjectView object() const; AreaView area() const;           // views in its memory
 //   void finish();                                               // waits, throws on a fault
 // Frames: poses X_GO (object O into the area's gravity frame G), as in backend.h.
@@ -187,7 +188,7 @@ class BatchedBackend : public Backend {
     out.assign(X.size(), {});
     const int cap = dev_.object().mesh.num_spheres;
     if (X.empty() || cap == 0) return;
-    const int levels = dev_.splitLevels();
+    const int levels = dev_.contactSplitLevels();
     const size_t items = X.size() << levels;
     SphereContact* dc = dev_.template scratch<SphereContact>(kContacts, X.size() * cap);
     int* dn = dev_.template scratch<int>(kCounts, items);

@@ -33,6 +33,7 @@ class CpuDevice {
   }
   // One work item per answer: a few workers, and a whole tree prunes best (batched_steps.h).
   int splitLevels() const { return 0; }
+  int contactSplitLevels() const { return 0; }
   const ObjectView& object() const { return obj_; }
   const AreaView& area() const { return area_; }
   template <typename F>

@@ -33,6 +33,15 @@ std::vector<Scene> scenesToCompare() {
   return s;
 }
 
+// The models every comparison builds from a scene, and the tilt parameters.
+struct Models {
+  explicit Models(const Scene& s)
+      : om(buildObjectModel(s.object, 0.0015)), am(buildAreaModel(s.area, {0, 0, -1}, 0.002, 0.0035, 0.0035)) {}
+  ObjectModel om;
+  AreaModel am;
+  TiltParams tp{0.002, 1e-6};
+};
+
 // Queries around the area's top: poses above it (distance), just touching (contacts) and
 // tilting about axes through points on it (rotations), in many orientations.
 struct Queries {
@@ -89,9 +98,10 @@ struct Host {  // the host models, as the CPU backend reads them
 TEST(BackendParity, QueriesHitOnTheCpu) {
   for (const Scene& s : scenesToCompare()) {
     SCOPED_TRACE(s.name);
-    const ObjectModel om = buildObjectModel(s.object, 0.0015);
-    const AreaModel am = buildAreaModel(s.area, {0, 0, -1}, 0.002, 0.0035, 0.0035);
-    auto cpu = makeCpuBackend(om, am, TiltParams{0.002, 1e-6}, 2);
+    const Models m(s);
+    const ObjectModel& om = m.om;
+    const AreaModel& am = m.am;
+    auto cpu = makeCpuBackend(om, am, m.tp, 2);
     const Queries q = queriesFor(om, am, *cpu);
     EXPECT_GE(q.contact.size(), q.t.size() * 3 / 4) << "distance queries missed the area";
     std::vector<std::vector<SphereContact>> c;
@@ -115,13 +125,11 @@ TEST(BackendParity, QueriesHitOnTheCpu) {
 TEST(BackendParity, SplitWorkItemsGiveTheWholeAnswers) {
   for (const Scene& s : scenesToCompare()) {
     SCOPED_TRACE(s.name);
-    const ObjectModel om = buildObjectModel(s.object, 0.0015);
-    const AreaModel am = buildAreaModel(s.area, {0, 0, -1}, 0.002, 0.0035, 0.0035);
-    const TiltParams tp{0.002, 1e-6};
-    auto cpu = makeCpuBackend(om, am, tp, 2);
-    const Queries q = queriesFor(om, am, *cpu);
-    const ObjectView o = makeObjectView(om, Host{});
-    const AreaView a = makeAreaView(am, Host{});
+    const Models m(s);
+    const TiltParams& tp = m.tp;
+    const Queries q = queriesFor(m.om, m.am, *makeCpuBackend(m.om, m.am, tp, 2));
+    const ObjectView o = makeObjectView(m.om, Host{});
+    const AreaView a = makeAreaView(m.am, Host{});
     auto run = [](size_t n, int levels, double* out, const auto& item) {
       for (size_t i = 0; i < n; ++i) FillItem{out, kInf}(i);
       for (size_t k = 0; k < (n << levels); ++k) item(k);
@@ -176,9 +184,10 @@ TEST(BackendParity, KernelsMatchValueByValue) {
   if (!cuda::available(&why)) GTEST_SKIP() << "no usable GPU (" << why << "): the CUDA kernels cannot run here";
   for (const Scene& s : scenesToCompare()) {
     SCOPED_TRACE(s.name);
-    const ObjectModel om = buildObjectModel(s.object, 0.0015);
-    const AreaModel am = buildAreaModel(s.area, {0, 0, -1}, 0.002, 0.0035, 0.0035);
-    const TiltParams tp{0.002, 1e-6};
+    const Models m(s);
+    const ObjectModel& om = m.om;
+    const AreaModel& am = m.am;
+    const TiltParams& tp = m.tp;
     auto cpu = makeCpuBackend(om, am, tp, 2);
     auto gpu = makeCudaBackend(om, am, tp);
     const Queries q = queriesFor(om, am, *cpu);

@@ -74,7 +74,7 @@ struct DistanceItem {  // V-A: one translation query
     const int part = static_cast<int>(k & ((size_t{1} << levels) - 1));
     const double h = firstContactDistance(o, a, q[i].X_GO, q[i].d, q[i].tmax, part, levels);
     if (levels == 0) t[i] = h;
-    else if (h < kInf) atomicMinNonNegative(t + i, maxv(h, 0.0));
+    else if (h < kInf) atomicMinNonNegative(t + i, maxv(h, 0.0));  // a pose already touching: 0
   }
 };
 

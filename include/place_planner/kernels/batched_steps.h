@@ -63,6 +63,14 @@ AreaView makeAreaView(const AreaModel& a, Up&& up) {
 // item k = (answer << levels) | part, met by an atomic minimum in an answer filled with kInf
 // first (FillItem): a GPU runs a few hundred poses per step, too few threads alone. 0: one item
 // per answer (the CPU's workers are few; a whole tree prunes best).
+PP_HD int partOf(size_t k, int levels) { return static_cast<int>(k & ((size_t{1} << levels) - 1)); }
+// An answer, or one part's of it: stored, or met by the atomic minimum (a pose already
+// touching, a distance under 0, as 0).
+PP_HD void meet(double* answer, double v, int levels) {
+  if (levels == 0) *answer = v;
+  else if (v < kInf) atomicMinNonNegative(answer, maxv(v, 0.0));
+}
+
 struct DistanceItem {  // V-A: one translation query
   ObjectView o;
   AreaView a;
@@ -71,10 +79,7 @@ struct DistanceItem {  // V-A: one translation query
   int levels = 0;
   PP_HD void operator()(size_t k) const {
     const size_t i = k >> levels;
-    const int part = static_cast<int>(k & ((size_t{1} << levels) - 1));
-    const double h = firstContactDistance(o, a, q[i].X_GO, q[i].d, q[i].tmax, part, levels);
-    if (levels == 0) t[i] = h;
-    else if (h < kInf) atomicMinNonNegative(t + i, maxv(h, 0.0));  // a pose already touching: 0
+    meet(t + i, firstContactDistance(o, a, q[i].X_GO, q[i].d, q[i].tmax, partOf(k, levels), levels), levels);
   }
 };
 
@@ -92,14 +97,13 @@ struct RotationItem {
   int window = -1;  // -1: every window
   PP_HD void operator()(size_t k) const {
     const size_t j = k >> levels, i = j / 2;
-    const int part = static_cast<int>(k & ((size_t{1} << levels) - 1));
+    const int part = partOf(k, levels);
     if (window > 0 && out[j] <= angleWindowStart(window)) return;
     const int sigma = j % 2 ? -1 : 1;
     const double limit = sigma > 0 ? q[i].limit_ccw : q[i].limit_cw;
     const double th = kVertex ? vertexSurfaceAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit, part, levels, window)
                               : edgeEdgeAngle(o, a, q[i].X_GO, q[i].s_A, q[i].d_A, sigma, tp, limit, part, levels, window);
-    if (levels == 0) out[j] = th;
-    else if (th < kInf) atomicMinNonNegative(out + j, th);
+    meet(out + j, th, levels);
   }
 };
 
@@ -124,7 +128,7 @@ struct ContactItem {
   int* first = nullptr;  // per item: its first slot (levels > 0)
   PP_HD void operator()(size_t k) const {
     const size_t i = k >> levels;
-    const int root = subtreeRoot(o.mesh.sphere_bvh, static_cast<int>(k & ((size_t{1} << levels) - 1)), levels);
+    const int root = subtreeRoot(o.mesh.sphere_bvh, partOf(k, levels), levels);
     const int start = levels > 0 && root >= 0 ? subtreeFirst(o.mesh.sphere_bvh, root) : 0;
     if (levels > 0) first[k] = start;
     const Rigid T = X[i];

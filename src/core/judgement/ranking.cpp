@@ -7,6 +7,7 @@
 #include "place_planner/judgement/contact_forces.h"
 #include "place_planner/search/contact_points.h"
 #include "place_planner/manipulation/placeability.h"
+#include "place_planner/infra/parallel_for.h"
 #include "place_planner/infra/stable_sort.h"
 
 namespace place_planner {
@@ -221,16 +222,19 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     return !(place && !it.placement.checked) && (it.placement.blocked.empty() || config.keep_colliding);
   };
   const ForceModelParams forces{config.friction, 8, 3.0};
-  int pushed = 0;
+  std::vector<Item*> to_push;
   for (Item& it : distinct) {
-    if (pushed >= config.max_candidates) break;
-    if (!returned(it) || !it.stable) continue;
+    if (static_cast<int>(to_push.size()) >= config.max_candidates) break;
+    if (returned(it) && it.stable) to_push.push_back(&it);
+  }
+  // One small LP per direction and candidate, each candidate on its own: over the threads.
+  parallelFor(to_push.size(), config.threads, [&](size_t k) {
+    Item& it = *to_push[k];
     const TreeLeaf& l = leaves[it.leaf];
     it.push = pushResistance(reduceContacts(l.contacts, in.object_radius / 10.0), toIsometry(l.X_GO) * in.com_O, forces,
                              1.0, std::min(0.003, in.object_radius / 10.0));
     it.pushed = true;
-    ++pushed;
-  }
+  });
   sortItems(distinct, leaves);
   for (const Item& it : distinct) {
     if (static_cast<int>(out.size()) >= config.max_candidates) break;

@@ -1,9 +1,11 @@
-# Bullet physics validation, the drop-and-settle baseline and the benchmark suite.
+# Bullet and MuJoCo physics validation, the drop-and-settle baseline and the benchmark suite.
 # Included by CMakeLists.txt after catkin_package(). Bullet is used here only: never in the core.
 
 # The Find module (not Debian's BulletConfig.cmake, whose paths are relative) gives absolute paths.
 find_package(Bullet REQUIRED)
 find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs)
+# The second engine of the placement check (mujoco_validator.h): Debian's libmujoco-dev.
+find_package(mujoco REQUIRED CONFIG)
 
 # ---------------------------------------------------------------- library
 file(GLOB PP_VALIDATION_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/validation/*.cpp)
@@ -13,7 +15,7 @@ target_include_directories(place_planner_validation SYSTEM PRIVATE
   ${BULLET_INCLUDE_DIRS} ${OpenCV_INCLUDE_DIRS})
 target_link_libraries(place_planner_validation
   PUBLIC place_planner_core
-  PRIVATE ${BULLET_LIBRARIES} ${OpenCV_LIBS})
+  PRIVATE ${BULLET_LIBRARIES} ${OpenCV_LIBS} mujoco::mujoco)
 target_compile_options(place_planner_validation PRIVATE ${PP_WARN})
 
 # ---------------------------------------------------------------- tools

@@ -21,7 +21,7 @@ PP_PACKAGES=(
   python3-shape-msgs python3-yaml
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libgtest-dev googletest rviz librviz-dev xvfb xauth imagemagick
-  libbullet-dev libbullet-extras-dev libtbb-dev libbenchmark-dev
+  libbullet-dev libbullet-extras-dev libmujoco-dev libtbb-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   clang libclang-rt-dev llvm
 )

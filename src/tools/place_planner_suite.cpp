@@ -55,6 +55,8 @@ double median(std::vector<double> v) {
                "  scans (DATA/scans), validated on the true meshes; writes OUT/scans.{md,csv}\n"
                "  [--hanging]  the hanging suite instead: looped objects on built-in peg walls and a\n"
                "  mug tree, placement hanging; writes OUT/hanging.{md,csv}\n"
+               "  [--mujoco]  also check each validated pose in MuJoCo, the second engine, and count\n"
+               "  the poses both engines keep\n"
                "  --auto-gravity: areas with under 5 %% of their surface facing up are planned and\n"
                "  validated with gravity against their largest flat region (area_up.h)\n",
                msg);
@@ -120,6 +122,7 @@ int runBestPoseSuite(const std::vector<ScenePair>& all_pairs, const std::vector<
   }
   struct Tally {
     int scenes = 0, best = 0, top3_validated = 0, top3_confirmed = 0, none_stable = 0;
+    int best_both = 0, top3_both = 0;  // confirmed in Bullet and MuJoCo (--mujoco)
     double plan_ms = 0;
   };
   std::map<std::string, Tally> by_mode, by_area;
@@ -134,14 +137,20 @@ int runBestPoseSuite(const std::vector<ScenePair>& all_pairs, const std::vector<
     for (Tally* t : {&by_mode[p.mode], &by_area[area], &total}) {
       ++t->scenes;
       t->best += r.bestConfirmed() ? 1 : 0;
+      t->best_both += r.bestConfirmedBoth() ? 1 : 0;
+      t->top3_both += r.confirmedBothOfTop(3);
       t->top3_validated += v3;
       t->top3_confirmed += c3;
       t->none_stable += r.stable == 0 ? 1 : 0;
       t->plan_ms += r.stats.total_ms;
     }
-    std::fprintf(stderr, "%-55s plan %7.1f ms  stable %2d  best %s  top-3 %d/%d  %s\n", p.name.c_str(),
+    std::string both;
+    if (cfg.mujoco)
+      both = std::string("  both engines: best ") + (r.checks.empty() ? "-" : r.bestConfirmedBoth() ? "yes" : "no") +
+             " top-3 " + std::to_string(r.confirmedBothOfTop(3)) + "/" + std::to_string(v3);
+    std::fprintf(stderr, "%-55s plan %7.1f ms  stable %2d  best %s  top-3 %d/%d%s  %s\n", p.name.c_str(),
                  r.stats.total_ms, r.stable, r.checks.empty() ? "-  " : r.bestConfirmed() ? "yes" : "no ", c3, v3,
-                 r.error.c_str());
+                 both.c_str(), r.error.c_str());
     char line[512];
     std::snprintf(line, sizeof line, "| %s | %s | %d | %s | %d/%d | %.0f |\n", p.name.c_str(), p.mode.c_str(),
                   r.stable, r.checks.empty() ? "-" : r.bestConfirmed() ? "yes" : "no", c3, v3, r.stats.total_ms);
@@ -150,15 +159,23 @@ int runBestPoseSuite(const std::vector<ScenePair>& all_pairs, const std::vector<
   }
   std::ostringstream md;
   md << intro << "\n\n"
-     << "| group | scenes | best confirmed | top-3 precision | nothing stable | mean plan ms |\n"
-     << "|---|---:|---:|---:|---:|---:|\n";
+     << "| group | scenes | best confirmed | top-3 precision | nothing stable | mean plan ms |"
+     << (cfg.mujoco ? " best, both engines | top-3, both engines |\n" : "\n")
+     << "|---|---:|---:|---:|---:|---:|" << (cfg.mujoco ? "---:|---:|\n" : "\n");
   auto line = [&](const std::string& name, const Tally& t) {
     char buf[256];
-    std::snprintf(buf, sizeof buf, "| %s | %d | %d/%d = %.2f | %d/%d = %.2f | %d | %.0f |\n", name.c_str(), t.scenes,
+    std::snprintf(buf, sizeof buf, "| %s | %d | %d/%d = %.2f | %d/%d = %.2f | %d | %.0f |", name.c_str(), t.scenes,
                   t.best, t.scenes, t.scenes ? double(t.best) / t.scenes : 0.0, t.top3_confirmed, t.top3_validated,
                   t.top3_validated ? double(t.top3_confirmed) / t.top3_validated : 0.0, t.none_stable,
                   t.scenes ? t.plan_ms / t.scenes : 0.0);
     md << buf;
+    if (cfg.mujoco) {
+      std::snprintf(buf, sizeof buf, " %d/%d = %.2f | %d/%d = %.2f |", t.best_both, t.scenes,
+                    t.scenes ? double(t.best_both) / t.scenes : 0.0, t.top3_both, t.top3_validated,
+                    t.top3_validated ? double(t.top3_both) / t.top3_validated : 0.0);
+      md << buf;
+    }
+    md << "\n";
   };
   for (const auto& [mode, t] : by_mode) line("mode " + mode, t);
   for (const auto& [area, t] : by_area) line("area " + area, t);
@@ -204,6 +221,7 @@ int main(int argc, char** argv) {
     else if (a == "--auto-gravity") cfg.auto_gravity = true;
     else if (a == "--scans") scan_areas = split(next());
     else if (a == "--hanging") hanging = true;
+    else if (a == "--mujoco") cfg.mujoco = true;
     // Planner options, to measure their effect on precision and coverage.
     else if (a == "--orientation") cfg.planner.orientation = orientationModeFromString(next());
     else if (a == "--robust-shift") cfg.planner.robust_shift = std::stod(next());
@@ -258,9 +276,12 @@ int main(int argc, char** argv) {
   std::vector<SceneResult> full;
   for (const auto& p : pairs) {
     SceneResult r = runScene(p, cfg);
-    std::fprintf(stderr, "%-40s plan %7.1f ms  fp %3d  stable %2d  confirmed %d/%d  drops rest %d/%zu"
+    const std::string both = cfg.mujoco ? "  MuJoCo " + std::to_string(r.confirmed_mujoco) + "/" +
+                                              std::to_string(r.validated) + " both " + std::to_string(r.confirmed_both)
+                                        : std::string();
+    std::fprintf(stderr, "%-40s plan %7.1f ms  fp %3d  stable %2d  confirmed %d/%d%s  drops rest %d/%zu"
                  " (%.1f ms)  %s\n", p.name.c_str(), r.stats.total_ms, r.stats.floor_points_total,
-                 r.stable, r.confirmed, r.validated, r.drops_at_rest, r.drops.size(), r.drop_ms_mean,
+                 r.stable, r.confirmed, r.validated, both.c_str(), r.drops_at_rest, r.drops.size(), r.drop_ms_mean,
                  r.error.c_str());
     full.push_back(std::move(r));
   }

@@ -1,6 +1,7 @@
 #include "place_planner/validation/suite.h"
 
 #include "place_planner/infra/output_file.h"
+#include "place_planner/validation/mujoco_validator.h"
 
 #include <sys/stat.h>
 
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -251,6 +253,8 @@ SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh&
     vc.friction = config.planner.friction;
     if (pc.gravity.norm() > 1e-9) vc.gravity = 9.81 * pc.gravity.normalized();
     const PhysicsValidator validator(object_full, area_true, vc);
+    std::unique_ptr<MujocoValidator> mujoco;
+    if (config.mujoco) mujoco = std::make_unique<MujocoValidator>(object_full, area_true, vc);
     const auto t0 = Clock::now();
     for (size_t k = 0; k < plan.candidates.size() && r.validated < config.max_validated; ++k) {
       const Candidate& c = plan.candidates[k];
@@ -261,6 +265,13 @@ SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh&
       cc.X_WO = c.X_WO;
       cc.check = validator.check(c.X_WO);
       if (c.hanging) cc.check.confirmed = stillHanging(cc.check, c.X_WO, object_full.properties.center_of_mass, vc);
+      if (mujoco) {
+        cc.mujoco_checked = true;
+        cc.mujoco = mujoco->check(c.X_WO);
+        if (c.hanging) cc.mujoco.confirmed = stillHanging(cc.mujoco, c.X_WO, object_full.properties.center_of_mass, vc);
+        r.confirmed_mujoco += cc.mujoco.confirmed ? 1 : 0;
+        r.confirmed_both += cc.bothConfirmed() ? 1 : 0;
+      }
       ++r.validated;
       r.confirmed += cc.check.confirmed ? 1 : 0;
       r.checks.push_back(cc);
@@ -359,7 +370,8 @@ void writeChecksCsv(const std::vector<SceneResult>& results, const std::string& 
   std::ostringstream os;
   os << "scene,variant,rank,quality,confirmed,moved_m,turned_deg,aborted,"
         "goal_x,goal_y,goal_z,goal_qw,goal_qx,goal_qy,goal_qz,"
-        "final_x,final_y,final_z,final_qw,final_qx,final_qy,final_qz\n";
+        "final_x,final_y,final_z,final_qw,final_qx,final_qy,final_qz,"
+        "mujoco_checked,mujoco_confirmed,mujoco_moved_m,mujoco_turned_deg\n";
   for (const auto& r : results)
     for (const auto& c : r.checks) {
       os << r.pair.name << ',' << r.variant << ',' << c.rank << ',' << c.quality << ','
@@ -368,7 +380,8 @@ void writeChecksCsv(const std::vector<SceneResult>& results, const std::string& 
       poseCsv(os, c.X_WO);
       os << ',';
       poseCsv(os, c.check.X_WO_final);
-      os << '\n';
+      os << ',' << c.mujoco_checked << ',' << c.mujoco.confirmed << ',' << c.mujoco.moved_m << ','
+         << c.mujoco.turned_deg << '\n';
     }
   writeOutputFile(path, os.str());
 }

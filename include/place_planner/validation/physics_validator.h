@@ -24,6 +24,7 @@
 #include <Eigen/Geometry>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "place_planner/model/mesh.h"
 #include "place_planner/planner.h"
@@ -192,6 +193,13 @@ VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerCo
 // plan had none, else what is left, at least a tiny positive amount (a spent budget checks
 // nothing; it must not read as "no limit").
 double remainingBudgetMs(double plan_budget_ms, double used_ms);
+
+// The convex pieces both engines simulate a non-convex mesh with (Bullet here, MuJoCo in
+// mujoco_validator.h): neighbouring triangles of similar normal (config.piece_max_normal_deg,
+// piece_max_size, piece_max_triangles) grouped, each group the point set of a slab thickened
+// inwards (against its normal) by config.piece_thickness, less where the other side is nearer,
+// and inset by the margins (config.margin: Bullet's; 0 for an engine without margins).
+std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const ValidatorConfig& config);
 
 // Rotation angle between two orientations, degrees in [0, 180].
 double rotationAngleDeg(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b);

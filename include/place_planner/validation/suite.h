@@ -52,6 +52,9 @@ struct SuiteConfig {
   // Where under 5 % of an area faces against planner.gravity (a scan in its camera frame),
   // plan and validate with gravity against the area's largest flat region (area_up.h).
   bool auto_gravity = false;
+  // Also check each validated pose in MuJoCo (mujoco_validator.h), the second engine: a pose
+  // is then confirmed in both engines when both keep it.
+  bool mujoco = false;
   SuiteConfig() { planner.threads = 1; }
 };
 
@@ -60,6 +63,9 @@ struct CandidateCheck {
   double quality = 0.0;
   Eigen::Isometry3d X_WO = Eigen::Isometry3d::Identity();
   PoseCheck check;
+  bool mujoco_checked = false;  // SuiteConfig::mujoco
+  PoseCheck mujoco;
+  bool bothConfirmed() const { return check.confirmed && mujoco_checked && mujoco.confirmed; }
 };
 
 struct DropRecord {
@@ -78,6 +84,8 @@ struct SceneResult {
   int stable = 0;                // returned as stable
   int validated = 0;             // stable candidates simulated (<= max_validated)
   int confirmed = 0;             // of those, confirmed by Bullet
+  int confirmed_mujoco = 0;      // ... by MuJoCo (SuiteConfig::mujoco)
+  int confirmed_both = 0;        // ... by both engines
   std::vector<CandidateCheck> checks;
   std::vector<DropRecord> drops;
   int drops_at_rest = 0;
@@ -91,6 +99,7 @@ struct SceneResult {
   double precision() const { return validated ? double(confirmed) / validated : 0.0; }
   // The best stable pose (the first validated) was confirmed.
   bool bestConfirmed() const { return !checks.empty() && checks.front().check.confirmed; }
+  bool bestConfirmedBoth() const { return !checks.empty() && checks.front().bothConfirmed(); }
   // Confirmed among the first k validated (the top-k stable poses).
   int confirmedOfTop(int k, int* validated_top) const {
     int n = 0, c = 0;
@@ -100,6 +109,12 @@ struct SceneResult {
         c += ch.check.confirmed ? 1 : 0;
       }
     *validated_top = n;
+    return c;
+  }
+  int confirmedBothOfTop(int k) const {
+    int n = 0, c = 0;
+    for (const auto& ch : checks)
+      if (n++ < k) c += ch.bothConfirmed() ? 1 : 0;
     return c;
   }
   bool plannerConfirmed() const { return confirmed > 0; }

@@ -1,0 +1,205 @@
+// MuJoCo check of placement poses (mujoco_validator.h).
+#include "place_planner/validation/mujoco_validator.h"
+
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "place_planner/search/loops.h"
+
+namespace place_planner {
+namespace validation {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr double kTimeStep = 0.001;     // s: a 4 ms contact time constant needs <= 2 ms
+constexpr double kMinThickness = 2e-4;  // m: a slab thinner than this is thickened (qhull needs a volume)
+
+// Each piece's point pairs (a surface point, the same point inside: convexPieces) kept at least
+// kMinThickness apart, so that MuJoCo's hull of the piece has a volume; a piece whose pairs
+// coincide everywhere (no inward direction) is dropped.
+bool thickened(std::vector<Eigen::Vector3d>& pts) {
+  Eigen::Vector3d dir = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i + 1 < pts.size(); i += 2) dir += pts[i + 1] - pts[i];
+  if (dir.norm() < 1e-12) return false;
+  dir.normalize();
+  for (size_t i = 0; i + 1 < pts.size(); i += 2)
+    if ((pts[i + 1] - pts[i]).dot(dir) < kMinThickness) pts[i + 1] = pts[i] + kMinThickness * dir;
+  return true;
+}
+
+void appendMesh(std::ostringstream& xml, const std::string& name, const std::vector<Eigen::Vector3d>& pts,
+                const Eigen::Vector3d& offset) {
+  xml << "<mesh name=\"" << name << "\" vertex=\"";
+  for (const auto& p : pts) xml << (p.x() - offset.x()) << ' ' << (p.y() - offset.y()) << ' ' << (p.z() - offset.z()) << ' ';
+  xml << "\"/>\n";
+}
+
+}  // namespace
+
+struct MujocoValidator::Impl {
+  ValidatorConfig cfg;
+  mjModel* model = nullptr;
+  Eigen::Vector3d c_O = Eigen::Vector3d::Zero();
+  int object_pieces = 0, area_pieces = 0;
+  double build_ms = 0.0;
+  ~Impl() {
+    if (model) mj_deleteModel(model);
+  }
+};
+
+MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const ValidatorConfig& config,
+                                 double piece_size)
+    : impl_(std::make_unique<Impl>()) {
+  if (object_O.triangles.empty()) throw std::invalid_argument("MujocoValidator: empty object mesh");
+  if (area_W.triangles.empty()) throw std::invalid_argument("MujocoValidator: empty area mesh");
+  const auto t0 = Clock::now();
+  Impl& d = *impl_;
+  d.cfg = config;
+  d.c_O = object_O.properties.center_of_mass;
+
+  // Pieces without margins (MuJoCo has none to make up for); the object's no larger than its
+  // narrowest loop (a hull must not bridge a handle's opening, as for Bullet).
+  ValidatorConfig pc = config;
+  pc.margin = 0.0;
+  pc.piece_max_size = std::min(config.piece_max_size, piece_size);
+  for (const Loop& l : findLoops(object_O)) pc.piece_max_size = std::min(pc.piece_max_size, l.radius);
+  std::vector<std::vector<Eigen::Vector3d>> object_pieces = convexPieces(object_O, pc);
+  // The area's slabs: its surface with 5 mm under it (less in thin walls), in pieces as small.
+  ValidatorConfig ac = pc;
+  ac.piece_max_size = piece_size;
+  ac.piece_thickness = 0.005;
+  std::vector<std::vector<Eigen::Vector3d>> area_pieces = convexPieces(area_W, ac);
+
+  const Eigen::Vector3d ext = object_O.properties.bounds_max - object_O.properties.bounds_min;
+  const double mass = config.density * std::max(ext.x(), 1e-3) * std::max(ext.y(), 1e-3) * std::max(ext.z(), 1e-3);
+  const Eigen::Vector3d inertia(mass / 12.0 * (ext.y() * ext.y() + ext.z() * ext.z()),
+                                mass / 12.0 * (ext.x() * ext.x() + ext.z() * ext.z()),
+                                mass / 12.0 * (ext.x() * ext.x() + ext.y() * ext.y()));
+
+  std::ostringstream xml;
+  xml.precision(9);
+  xml << "<mujoco model=\"placement\">\n<option timestep=\"" << kTimeStep << "\" gravity=\"" << config.gravity.x()
+      << ' ' << config.gravity.y() << ' ' << config.gravity.z() << "\" cone=\"elliptic\" impratio=\"10\"/>\n"
+      << "<default><geom condim=\"3\" friction=\"" << config.friction
+      << " 0 0\" solref=\"0.004 1\" density=\"0\"/></default>\n<asset>\n";
+  std::vector<std::string> area_names, object_names;
+  for (auto& p : area_pieces) {
+    if (!thickened(p)) continue;
+    area_names.push_back("a" + std::to_string(area_names.size()));
+    appendMesh(xml, area_names.back(), p, Eigen::Vector3d::Zero());
+  }
+  for (auto& p : object_pieces) {
+    if (!thickened(p)) continue;
+    object_names.push_back("o" + std::to_string(object_names.size()));
+    appendMesh(xml, object_names.back(), p, d.c_O);  // body frame: origin c_O, axes of O
+  }
+  xml << "</asset>\n<worldbody>\n";
+  for (const auto& n : area_names) xml << "<geom type=\"mesh\" mesh=\"" << n << "\"/>\n";
+  xml << "<body name=\"object\"><freejoint/>\n<inertial pos=\"0 0 0\" mass=\"" << mass << "\" diaginertia=\""
+      << inertia.x() << ' ' << inertia.y() << ' ' << inertia.z() << "\"/>\n";
+  for (const auto& n : object_names) xml << "<geom type=\"mesh\" mesh=\"" << n << "\"/>\n";
+  xml << "</body>\n</worldbody>\n</mujoco>\n";
+  if (object_names.empty()) throw std::runtime_error("MujocoValidator: the object has no convex piece");
+
+  // Compiled from memory (a virtual file).
+  const std::string text = xml.str();
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  if (mj_makeEmptyFileVFS(vfs.get(), "placement.xml", static_cast<int>(text.size())) != 0)
+    throw std::runtime_error("MujocoValidator: the model does not fit MuJoCo's virtual file");
+  std::memcpy(vfs->filedata[vfs->nfile - 1], text.data(), text.size());
+  char error[1000] = "";
+  static std::mutex compiling;  // MuJoCo's XML compiler is not known to be reentrant
+  std::lock_guard<std::mutex> lock(compiling);
+  d.model = mj_loadXML("placement.xml", vfs.get(), error, sizeof error);
+  mj_deleteVFS(vfs.get());
+  if (!d.model) throw std::runtime_error(std::string("MujocoValidator: MuJoCo did not compile the scene: ") + error);
+  // Velocity damping as Bullet's: the share lost per second, per degree of freedom.
+  const double k = -std::log(1.0 - std::clamp(config.linear_damping, 0.0, 0.99));
+  const double ka = -std::log(1.0 - std::clamp(config.angular_damping, 0.0, 0.99));
+  for (int i = 0; i < 3; ++i) {
+    d.model->dof_damping[i] = k * mass;
+    d.model->dof_damping[3 + i] = ka * inertia[i];
+  }
+  d.object_pieces = static_cast<int>(object_names.size());
+  d.area_pieces = static_cast<int>(area_names.size());
+  d.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+MujocoValidator::~MujocoValidator() = default;
+
+int MujocoValidator::objectPieces() const { return impl_->object_pieces; }
+int MujocoValidator::areaPieces() const { return impl_->area_pieces; }
+double MujocoValidator::buildMs() const { return impl_->build_ms; }
+
+PoseCheck MujocoValidator::check(const Eigen::Isometry3d& X_WO_goal) const {
+  const auto t0 = Clock::now();
+  const Impl& d = *impl_;
+  const ValidatorConfig& c = d.cfg;
+  mjData* data = mj_makeData(d.model);
+  const Eigen::Vector3d up = -c.gravity.normalized();
+  // The body's frame: origin at the centre of mass, axes of O; released release_gap higher.
+  const Eigen::Vector3d p0 = X_WO_goal * d.c_O + c.release_gap * up;
+  const Eigen::Quaterniond q0(X_WO_goal.linear());
+  const double qpos[7] = {p0.x(), p0.y(), p0.z(), q0.w(), q0.x(), q0.y(), q0.z()};
+  std::copy(qpos, qpos + 7, data->qpos);
+  mj_forward(d.model, data);
+  const Eigen::Vector3d p_goal = X_WO_goal * d.c_O;
+  auto pose = [&] {
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.linear() = Eigen::Quaterniond(data->qpos[3], data->qpos[4], data->qpos[5], data->qpos[6]).normalized().toRotationMatrix();
+    X.translation() = Eigen::Vector3d(data->qpos[0], data->qpos[1], data->qpos[2]) - X.linear() * d.c_O;
+    return X;
+  };
+  const int steps = static_cast<int>(std::ceil(c.settle_time / kTimeStep - 1e-9));
+  // Bullet's early accept is counted in its steps (1/480 s): the same stretch of time here.
+  const int calm_steps = static_cast<int>(std::lround(c.early_accept_steps * c.time_step / kTimeStep));
+  PoseCheck r;
+  int calm = 0;
+  for (int i = 0; i < steps; ++i) {
+    mj_step(d.model, data);
+    r.sim_time += kTimeStep;
+    if (calm_steps > 0) {
+      const Eigen::Vector3d v(data->qvel[0], data->qvel[1], data->qvel[2]);
+      const Eigen::Vector3d w(data->qvel[3], data->qvel[4], data->qvel[5]);
+      calm = (v.norm() < c.early_accept_linear && w.norm() < c.early_accept_angular) ? calm + 1 : 0;
+      if (calm >= calm_steps) {
+        const Eigen::Isometry3d X = pose();
+        if ((X * d.c_O - p_goal).norm() < 0.5 * c.max_translation &&
+            rotationAngleDeg(X.linear(), X_WO_goal.linear()) < 0.5 * c.max_rotation_deg) {
+          r.early_accepted = true;
+          break;
+        }
+      }
+    }
+    if ((i & 31) == 31) {
+      const Eigen::Isometry3d X = pose();
+      if ((X * d.c_O - p_goal).norm() > c.abort_translation ||
+          rotationAngleDeg(X.linear(), X_WO_goal.linear()) > c.abort_rotation_deg) {
+        r.aborted = true;
+        break;
+      }
+    }
+  }
+  r.X_WO_final = pose();
+  mj_deleteData(data);
+  r.moved_m = (r.X_WO_final * d.c_O - p_goal).norm();
+  r.turned_deg = rotationAngleDeg(r.X_WO_final.linear(), X_WO_goal.linear());
+  r.confirmed = !r.aborted && (r.early_accepted || (r.moved_m < c.max_translation && r.turned_deg < c.max_rotation_deg));
+  r.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  return r;
+}
+
+}  // namespace validation
+}  // namespace place_planner

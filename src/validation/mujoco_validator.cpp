@@ -5,6 +5,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -24,6 +26,11 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kTimeStep = 0.001;     // s: a 4 ms contact time constant needs <= 2 ms
 constexpr double kMinThickness = 2e-4;  // m: a slab thinner than this is thickened (qhull needs a volume)
+constexpr size_t kMaxTriangles = 200000;  // subdivided() stops splitting there (bounded work)
+// Contacts MuJoCo 2.2 preallocates (its default, 100, overflowed with a cube on a slope: its
+// warning, and contacts dropped); 3 constraint rows each (elliptic cones), whose dense
+// matrices are its square (2000 contacts did not fit in memory).
+constexpr int kMaxContacts = 500;
 
 // Each piece's point pairs (a surface point, the same point inside: convexPieces) kept at least
 // kMinThickness apart, so that MuJoCo's hull of the piece has a volume; a piece whose pairs
@@ -36,6 +43,43 @@ bool thickened(std::vector<Eigen::Vector3d>& pts) {
   for (size_t i = 0; i + 1 < pts.size(); i += 2)
     if ((pts[i + 1] - pts[i]).dot(dir) < kMinThickness) pts[i + 1] = pts[i] + kMinThickness * dir;
   return true;
+}
+
+// The mesh with every triangle longer than `max_edge` split at its longest edge's middle (the
+// middles shared, so neighbours stay neighbours), until none is. MuJoCo 2.2 finds the contact
+// of two convex shapes by MPR, along the line between their centres: a contact near the end of
+// a long slab came out along that line, sideways (a plate beside the seam of a two-triangle
+// table slid 6 cm). Pieces about as long as they are thick keep the contact normal true.
+Mesh subdivided(const Mesh& mesh, double max_edge) {
+  std::vector<Eigen::Vector3d> v = mesh.vertices;
+  std::map<std::pair<int, int>, int> middle;
+  auto mid = [&](int a, int b) {
+    const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+    auto it = middle.find(key);
+    if (it != middle.end()) return it->second;
+    v.push_back(0.5 * (v[a] + v[b]));
+    return middle[key] = static_cast<int>(v.size()) - 1;
+  };
+  std::vector<std::array<int, 3>> todo(mesh.triangles.rbegin(), mesh.triangles.rend());
+  std::vector<std::vector<int>> out;
+  while (!todo.empty()) {
+    const std::array<int, 3> t = todo.back();
+    todo.pop_back();
+    int longest = 0;
+    double len = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double l = (v[t[(k + 1) % 3]] - v[t[k]]).norm();
+      if (l > len) len = l, longest = k;
+    }
+    if (len <= max_edge || out.size() + todo.size() > kMaxTriangles) {
+      out.push_back({t[0], t[1], t[2]});
+      continue;
+    }
+    const int a = t[longest], b = t[(longest + 1) % 3], c = t[(longest + 2) % 3], m = mid(a, b);
+    todo.push_back({m, b, c});
+    todo.push_back({a, m, c});
+  }
+  return buildMesh(v, out, "subdivided mesh");
 }
 
 void appendMesh(std::ostringstream& xml, const std::string& name, const std::vector<Eigen::Vector3d>& pts,
@@ -72,14 +116,18 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   // narrowest loop (a hull must not bridge a handle's opening, as for Bullet).
   ValidatorConfig pc = config;
   pc.margin = 0.0;
+  pc.piece_max_triangles = 1000;  // pieces bounded by their size (a fine mesh's too)
   pc.piece_max_size = std::min(config.piece_max_size, piece_size);
   for (const Loop& l : findLoops(object_O)) pc.piece_max_size = std::min(pc.piece_max_size, l.radius);
-  std::vector<std::vector<Eigen::Vector3d>> object_pieces = convexPieces(object_O, pc);
-  // The area's slabs: its surface with 5 mm under it (less in thin walls), in pieces as small.
+  // The area's slabs: its surface with 1 cm under it (less in thin walls), pieces twice as large
+  // (a slab's contact normal stays true while the pieces are about as long as they are thick,
+  // subdivided() above; a 2 cm plate piece on a 4 cm slab: exact; on a 4 cm one both ways it
+  // turned 8 degrees).
   ValidatorConfig ac = pc;
-  ac.piece_max_size = piece_size;
-  ac.piece_thickness = 0.005;
-  std::vector<std::vector<Eigen::Vector3d>> area_pieces = convexPieces(area_W, ac);
+  ac.piece_max_size = 2.0 * piece_size;
+  ac.piece_thickness = 0.01;
+  std::vector<std::vector<Eigen::Vector3d>> object_pieces = convexPieces(subdivided(object_O, 0.5 * pc.piece_max_size), pc);
+  std::vector<std::vector<Eigen::Vector3d>> area_pieces = convexPieces(subdivided(area_W, 0.5 * ac.piece_max_size), ac);
 
   const Eigen::Vector3d ext = object_O.properties.bounds_max - object_O.properties.bounds_min;
   const double mass = config.density * std::max(ext.x(), 1e-3) * std::max(ext.y(), 1e-3) * std::max(ext.z(), 1e-3);
@@ -89,10 +137,10 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
 
   std::ostringstream xml;
   xml.precision(9);
-  xml << "<mujoco model=\"placement\">\n<option timestep=\"" << kTimeStep << "\" gravity=\"" << config.gravity.x()
-      << ' ' << config.gravity.y() << ' ' << config.gravity.z() << "\" cone=\"elliptic\" impratio=\"10\"/>\n"
+  xml << "<mujoco model=\"placement\">\n<compiler inertiafromgeom=\"false\"/>\n<size nconmax=\"" << kMaxContacts << "\" njmax=\"" << 3 * kMaxContacts << "\"/>\n<option timestep=\"" << kTimeStep << "\" gravity=\"" << config.gravity.x()
+      << ' ' << config.gravity.y() << ' ' << config.gravity.z() << "\" cone=\"elliptic\" impratio=\"10\"" << "/>\n"
       << "<default><geom condim=\"3\" friction=\"" << config.friction
-      << " 0 0\" solref=\"0.004 1\" density=\"0\"/></default>\n<asset>\n";
+      << " 0 0\" solref=\"" << "0.004 1" << "\"/></default>\n<asset>\n";
   std::vector<std::string> area_names, object_names;
   for (auto& p : area_pieces) {
     if (!thickened(p)) continue;
@@ -105,7 +153,9 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
     appendMesh(xml, object_names.back(), p, d.c_O);  // body frame: origin c_O, axes of O
   }
   xml << "</asset>\n<worldbody>\n";
-  for (const auto& n : area_names) xml << "<geom type=\"mesh\" mesh=\"" << n << "\"/>\n";
+  // Each area piece a static body of its own: MuJoCo 2.2 prunes by bodies (sweep and prune),
+  // then tests every geom pair of two bodies; in one world body the object met every piece.
+  for (const auto& n : area_names) xml << "<body><geom type=\"mesh\" mesh=\"" << n << "\"/></body>\n";
   xml << "<body name=\"object\"><freejoint/>\n<inertial pos=\"0 0 0\" mass=\"" << mass << "\" diaginertia=\""
       << inertia.x() << ' ' << inertia.y() << ' ' << inertia.z() << "\"/>\n";
   for (const auto& n : object_names) xml << "<geom type=\"mesh\" mesh=\"" << n << "\"/>\n";

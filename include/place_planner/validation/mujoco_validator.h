@@ -7,9 +7,12 @@
 // Model (measured on this machine: a cube on a plane tilted 10 and 12 degrees at mu 0.2 sticks
 // and slides, 15 and 20 degrees at mu 0.3 the same: tan(slope) = mu decides; test_mujoco_validator):
 //  - object and area both as convex pieces (convexPieces, no margins): MuJoCo 2.2 finds one
-//    contact point between two convex meshes, so a face resting on the area must be several
-//    pieces (at most piece_size across) to rest on several points; the area's pieces are slabs
-//    under its surface (MuJoCo collides a mesh as its convex hull);
+//    contact point between two convex meshes, by MPR along the line between their centres, so a
+//    face resting on the area must be several pieces to rest on several points, and a piece
+//    must be about as long as it is thick for its contact normal to be true: the object in
+//    pieces of at most piece_size (2 cm), the area in slabs twice that, 1 cm under its surface
+//    (less in thin walls), both meshes first split to edges of half their piece size; each area
+//    slab a static body of its own (MuJoCo prunes pairs by bodies);
 //  - friction mu on both (MuJoCo takes the larger), elliptic cones (impratio 10), contacts
 //    stiffened to a 4 ms time constant at a 1 ms step; no restitution;
 //  - mass and inertia as Bullet's: density x bounding box, its solid-box inertia about c_O;

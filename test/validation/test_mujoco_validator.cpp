@@ -1,0 +1,116 @@
+// The MuJoCo validator (the suites' second engine) on cases whose answer is known by hand, and
+// against Bullet on a real scene.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "place_planner/infra/mesh_io.h"
+#include "place_planner/infra/scenes.h"
+#include "place_planner/planner.h"
+#include "place_planner/validation/mujoco_validator.h"
+#include "place_planner/validation/physics_validator.h"
+#include "validation_test_helpers.h"
+
+namespace place_planner {
+namespace validation {
+namespace {
+
+Eigen::Isometry3d tiltedX(double deg, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  X.translation() = t;
+  return X;
+}
+
+ValidatorConfig withFriction(double mu) {
+  ValidatorConfig c;
+  c.friction = mu;
+  return c;
+}
+
+// The 10 cm cube (its frame at the centre of its bottom face) flat on the table stays; on a
+// corner it falls.
+TEST(MujocoValidator, CubeFlatStaysAndCubeOnAnEdgeFalls) {
+  MujocoValidator v(scenes::byName("cube"), scenes::table(), withFriction(0.2));
+  EXPECT_GE(v.objectPieces(), 6);  // a face rests on several pieces: several contacts
+  const PoseCheck flat = v.check(Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(flat.confirmed) << "moved " << flat.moved_m << " m, turned " << flat.turned_deg << " deg";
+  EXPECT_LT(flat.moved_m, 0.003);  // the 2 mm release gap
+  EXPECT_LT(flat.turned_deg, 0.5);
+  // Turned 30 degrees about x, resting on the edge y = -5 cm: the centre of mass is beyond it.
+  const Eigen::Isometry3d edge = tiltedX(30.0, Eigen::Vector3d(0, 0.05 - 0.05 * std::cos(M_PI / 6), 0.05 * std::sin(M_PI / 6)));
+  const PoseCheck r = v.check(edge);
+  EXPECT_FALSE(r.confirmed);
+  EXPECT_GT(r.turned_deg, 10.0);
+}
+
+// The friction law on a slope, both sides of tan(slope) = mu, as Bullet's test of the same.
+TEST(MujocoValidator, CubeOnASlopeSticksOrSlidesByFriction) {
+  struct Case {
+    double slope_deg, mu;
+    bool sticks;
+  };
+  for (const Case& k : {Case{20.0, 0.3, false}, Case{20.0, 0.4, true}, Case{30.0, 0.2, false}, Case{5.0, 0.2, true}}) {
+    MujocoValidator v(scenes::byName("cube"), scenes::plane(1.0, 1.0, k.slope_deg), withFriction(k.mu));
+    const PoseCheck r = v.check(tiltedX(k.slope_deg));
+    EXPECT_EQ(r.confirmed, k.sticks) << k.slope_deg << " deg at mu " << k.mu << ": moved " << r.moved_m << " m";
+    if (!k.sticks) EXPECT_GT(r.moved_m, 0.01);
+  }
+}
+
+// A can lying across a 10 degree slope's fall line rolls down it however rough the slope;
+// lying along the fall line at mu 0.8 (tan 10 = 0.18) it stays.
+TEST(MujocoValidator, CanRollsAcrossASlopeAndStaysAlongIt) {
+  const Mesh can = scenes::cylinder(0.03, 0.12, 32);  // axis z, centred at its origin
+  MujocoValidator v(can, scenes::plane(1.0, 1.0, 10.0), withFriction(0.8));
+  const Eigen::Isometry3d slope = tiltedX(10.0);
+  auto lying = [&](const Eigen::Vector3d& axis) {
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    // On a side facet (turned half a facet about its axis), the facet's distance above the slope.
+    X.linear() = slope.linear() * Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix() *
+                 Eigen::AngleAxisd(M_PI / 32, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    X.translation() = slope.linear() * Eigen::Vector3d(0, 0, 0.03 * std::cos(M_PI / 32));
+    return X;
+  };
+  const PoseCheck across = v.check(lying(Eigen::Vector3d::UnitX()));
+  EXPECT_FALSE(across.confirmed);
+  EXPECT_GT(across.moved_m, 0.01);
+  const PoseCheck along = v.check(lying(Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(along.confirmed) << "moved " << along.moved_m << " m, turned " << along.turned_deg << " deg";
+  // Bullet the same.
+  const PhysicsValidator bullet(can, scenes::plane(1.0, 1.0, 10.0), withFriction(0.8));
+  EXPECT_FALSE(bullet.check(lying(Eigen::Vector3d::UnitX())).confirmed);
+  EXPECT_TRUE(bullet.check(lying(Eigen::Vector3d::UnitY())).confirmed);
+}
+
+// The two engines agree on the planner's best poses of the 1k mug on the table, and on a
+// pose that is not stable.
+TEST(MujocoValidator, AgreesWithBulletOnTheMugsBestPoses) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh table = scenes::table();
+  PlannerConfig pc;
+  pc.max_candidates = 3;
+  const PlanResult plan = Planner().plan(mug, table, pc);
+  ASSERT_GE(plan.stableCount(), 1);
+  const ValidatorConfig vc = withFriction(pc.friction);
+  const PhysicsValidator bullet(mug, table, vc);
+  const MujocoValidator mujoco(mug, table, vc);
+  for (const Candidate& c : plan.candidates) {
+    if (!c.stable) continue;
+    const PoseCheck b = bullet.check(c.X_WO), m = mujoco.check(c.X_WO);
+    EXPECT_TRUE(b.confirmed);
+    EXPECT_TRUE(m.confirmed) << "MuJoCo: moved " << m.moved_m << " m, turned " << m.turned_deg << " deg";
+  }
+  // The best pose turned 40 degrees about a horizontal axis and lifted clear: both drop it.
+  Eigen::Isometry3d X = plan.candidates.front().X_WO;
+  X.linear() = Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix() * X.linear();
+  X.translation().z() += 0.05;
+  EXPECT_FALSE(bullet.check(X).confirmed);
+  EXPECT_FALSE(mujoco.check(X).confirmed);
+}
+
+}  // namespace
+}  // namespace validation
+}  // namespace place_planner

@@ -10,7 +10,7 @@
 //    contact point between two convex meshes, by MPR along the line between their centres, so a
 //    face resting on the area must be several pieces to rest on several points, and a piece
 //    must be about as long as it is thick for its contact normal to be true: the object in
-//    pieces of at most piece_size (2 cm), the area in slabs twice that, 1 cm under its surface
+//    pieces of at most piece_size (2 cm), the area in slabs twice that, 2 cm under its surface
 //    (less in thin walls), both meshes first split to edges of half their piece size; each area
 //    slab a static body of its own (MuJoCo prunes pairs by bodies);
 //  - friction mu on both (MuJoCo takes the larger), elliptic cones (impratio 10), contacts

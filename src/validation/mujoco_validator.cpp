@@ -127,6 +127,7 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   ValidatorConfig ac = pc;
   ac.piece_max_size = 2.0 * piece_size;
   ac.piece_thickness = 0.02;
+  ac.piece_full_depth_along = -config.gravity;  // floors and shelves: thick even where thin
   std::vector<std::vector<Eigen::Vector3d>> object_pieces = convexPieces(subdivided(object_O, 0.5 * pc.piece_max_size), pc);
   std::vector<std::vector<Eigen::Vector3d>> area_pieces = convexPieces(subdivided(area_W, 0.5 * ac.piece_max_size), ac);
 

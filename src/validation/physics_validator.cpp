@@ -221,7 +221,9 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
         const Eigen::Vector3d start = p - 1e-6 * n;
         depth = std::min(depth, rayDepth(m, start, -n, grid.near(start, start - reach * n), group));
       }
-    const double thickness = std::min(depth, c.piece_thickness);
+    const bool full = c.piece_full_depth_along.norm() > 0 &&
+                      n.dot(c.piece_full_depth_along.normalized()) > std::cos(M_PI / 4);
+    const double thickness = full ? c.piece_thickness : std::min(depth, c.piece_thickness);
     // The hull is shrunk by both margins (object's and area's) below, but Bullet shrinks a hull
     // by at most kShrinkClamp of its inner radius (about half a slab's thickness): a thin slab
     // keeps most of the margins, and a mug's 1.5 mm bottom rested 5-7 mm above the table (with

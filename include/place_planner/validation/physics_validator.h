@@ -55,6 +55,11 @@ struct ValidatorConfig {
   int piece_max_triangles = 32;          // triangles per convex piece at most
   double piece_max_normal_deg = 40.0;    // piece triangles' normals within this of the seed's
   double piece_max_size = 0.05;          // m, largest distance of a piece triangle from its seed
+  // Pieces whose normal is within 45 degrees of this direction keep the whole piece_thickness,
+  // however near the other side (zero: off). MuJoCo's area (mujoco_validator.h): a floor's
+  // slab may reach below a thin floor, where nothing rests, and must be thick to give a true
+  // contact normal.
+  Eigen::Vector3d piece_full_depth_along = Eigen::Vector3d::Zero();
   // An object with a loop (search/loops.h: a handle's opening, a ring's hole) is cut into pieces
   // no larger than its narrowest loop's radius, so that no piece's hull bridges the opening.
   // Measured: the YCB mug hung by its handle on a peg, with 5 cm pieces, was pushed off the peg

@@ -9,6 +9,7 @@
 #include <map>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <sstream>
@@ -171,6 +172,9 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   if (mj_makeEmptyFileVFS(vfs.get(), "placement.xml", static_cast<int>(text.size())) != 0)
     throw std::runtime_error("MujocoValidator: the model does not fit MuJoCo's virtual file");
   std::memcpy(vfs->filedata[vfs->nfile - 1], text.data(), text.size());
+  // MuJoCo's warnings (a full contact buffer) to stderr, not to a MUJOCO_LOG.TXT in the
+  // caller's folder; a handler the program set stays.
+  if (!mju_user_warning) mju_user_warning = [](const char* msg) { std::fprintf(stderr, "MuJoCo: %s\n", msg); };
   char error[1000] = "";
   static std::mutex compiling;  // MuJoCo's XML compiler is not known to be reentrant
   std::lock_guard<std::mutex> lock(compiling);

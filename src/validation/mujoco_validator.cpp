@@ -132,11 +132,9 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   std::vector<std::vector<Eigen::Vector3d>> object_pieces = convexPieces(subdivided(object_O, 0.5 * pc.piece_max_size), pc);
   std::vector<std::vector<Eigen::Vector3d>> area_pieces = convexPieces(subdivided(area_W, 0.5 * ac.piece_max_size), ac);
 
-  const Eigen::Vector3d ext = object_O.properties.bounds_max - object_O.properties.bounds_min;
-  const double mass = config.density * std::max(ext.x(), 1e-3) * std::max(ext.y(), 1e-3) * std::max(ext.z(), 1e-3);
-  const Eigen::Vector3d inertia(mass / 12.0 * (ext.y() * ext.y() + ext.z() * ext.z()),
-                                mass / 12.0 * (ext.x() * ext.x() + ext.z() * ext.z()),
-                                mass / 12.0 * (ext.x() * ext.x() + ext.y() * ext.y()));
+  const BoxBody body = boxBody(object_O, config.density);  // as Bullet's
+  const double mass = body.mass;
+  const Eigen::Vector3d& inertia = body.inertia;
 
   std::ostringstream xml;
   xml.precision(9);

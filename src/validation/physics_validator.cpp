@@ -303,6 +303,15 @@ std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const V
   return makeConvexPieces(mesh, config);
 }
 
+BoxBody boxBody(const Mesh& object_O, double density) {
+  const Eigen::Vector3d ext = object_O.properties.bounds_max - object_O.properties.bounds_min;
+  BoxBody b;
+  b.mass = density * std::max(ext.x(), 1e-3) * std::max(ext.y(), 1e-3) * std::max(ext.z(), 1e-3);
+  b.inertia = b.mass / 12.0 * Eigen::Vector3d(ext.y() * ext.y() + ext.z() * ext.z(), ext.x() * ext.x() + ext.z() * ext.z(),
+                                             ext.x() * ext.x() + ext.y() * ext.y());
+  return b;
+}
+
 double rotationAngleDeg(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
   const double c = std::clamp(((R_a.transpose() * R_b).trace() - 1.0) / 2.0, -1.0, 1.0);
   return std::acos(c) * 180.0 / M_PI;
@@ -441,12 +450,9 @@ PhysicsValidator::PhysicsValidator(const Mesh& object_O, const Mesh& area_W,
     d.object_shape->addChildShape(I, hull.get());
     d.hulls.push_back(std::move(hull));
   }
-  const Eigen::Vector3d ext = object_O.properties.bounds_max - object_O.properties.bounds_min;
-  d.mass = config.density * std::max(ext.x(), 1e-3) * std::max(ext.y(), 1e-3) * std::max(ext.z(), 1e-3);
-  // Solid box of the bounding box's size, about its centre (taken at c_O), in Bullet's units.
-  d.inertia = btVector3(btScalar(S * S * d.mass / 12.0 * (ext.y() * ext.y() + ext.z() * ext.z())),
-                        btScalar(S * S * d.mass / 12.0 * (ext.x() * ext.x() + ext.z() * ext.z())),
-                        btScalar(S * S * d.mass / 12.0 * (ext.x() * ext.x() + ext.y() * ext.y())));
+  const BoxBody body = boxBody(object_O, config.density);
+  d.mass = body.mass;
+  d.inertia = toBt(Eigen::Vector3d(S * S * body.inertia));  // in Bullet's units
 
   // Area: one static BVH triangle mesh.
   d.area_triangles = std::make_unique<btTriangleMesh>(true, false);

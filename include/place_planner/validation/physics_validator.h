@@ -206,6 +206,14 @@ double remainingBudgetMs(double plan_budget_ms, double used_ms);
 // and inset by the margins (config.margin: Bullet's; 0 for an engine without margins).
 std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const ValidatorConfig& config);
 
+// The object's rigid body in both engines: mass = density x bounding-box volume, and the
+// principal moments (kg m^2, about c_O along the axes of O) of that solid box.
+struct BoxBody {
+  double mass = 0.0;
+  Eigen::Vector3d inertia = Eigen::Vector3d::Zero();
+};
+BoxBody boxBody(const Mesh& object_O, double density);
+
 // Rotation angle between two orientations, degrees in [0, 180].
 double rotationAngleDeg(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b);
 

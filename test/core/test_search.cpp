@@ -396,6 +396,44 @@ TEST(Search, LeaningBoardSlidesToTheStopBehindItsFoot) {
   EXPECT_NEAR(low, 0.0, 0.004) << "its foot is not on the floor";
 }
 
+// The same with a rod 1 cm wide: its contacts at the foot and on the wall lie within a tenth
+// of their length of one steep line, but neither turn about that line lowers the rod without
+// pushing a corner into the floor or the wall. That is no hinge: the rod is judged as resting
+// there, and slides to the stop (the tree turned it about the line before, found both turns
+// blocked and ended, not stable).
+TEST(Search, LeaningRodOnANarrowFootIsNoHinge) {
+  const Mesh rod = scenes::box(0.01, 0.01, 0.25);
+  const Mesh area = scenes::merge({scenes::box(0.6, 0.3, 0.02, {0, 0, -0.01}), scenes::box(0.02, 0.3, 0.3, {0.11, 0, 0.15}),
+                                   scenes::box(0.02, 0.3, 0.015, {-0.08, 0, 0.0075})},
+                                  "wall and stop");
+  TreeScene scene(rod, area, 0.0015, 0.00225, 0.2);
+  scene.ctx.rock_settle = true;  // the planner's default
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(35 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  double xmax = -1, zmin = 1;
+  for (const auto& v : rod.vertices) {
+    xmax = std::max(xmax, (X.linear() * v).x());
+    zmin = std::min(zmin, (X.linear() * v).z());
+  }
+  X.translation() = Eigen::Vector3d(0.095 - xmax, 0, 0.003 - zmin);
+  const std::vector<TreeLeaf> leaves = settle(scene.ctx, X, scene.om.com, 0.1);
+  ASSERT_FALSE(leaves.empty());
+  const TreeLeaf* rest = nullptr;
+  for (const TreeLeaf& l : leaves)
+    if (l.stable && !rest) rest = &l;
+  ASSERT_NE(rest, nullptr) << "the rod did not come to rest between the wall and the stop";
+  double lo = 1, hi = -1, low = 1;
+  for (const auto& v : rod.vertices) {
+    const V3 q = apply(rest->X_GO, toV3(v));
+    lo = std::min(lo, q.x);
+    hi = std::max(hi, q.x);
+    low = std::min(low, q.z);
+  }
+  EXPECT_NEAR(lo, -0.07, 0.004) << "its foot is not against the stop";
+  EXPECT_NEAR(hi, 0.1, 0.004) << "its top is not on the wall";
+  EXPECT_NEAR(low, 0.0, 0.004) << "its foot is not on the floor";
+}
+
 // A ring (torus, axis along y) dropped over a horizontal square peg with its centre 1 cm to
 // the side: it lands on the peg's near corner, swings about it (the exact rotation to where its
 // centre of mass is lowest, or to the next contact) and hangs with its centre of mass straight

@@ -113,6 +113,15 @@ bool blocked(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& s
   return false;
 }
 
+// Whether a turn about the axis (s, d) that does not raise the centre of mass com is free of
+// the contacts (tiltStep's limits: the uphill turn is not followed, a blocked one not searched).
+bool downhillTurn(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com, const Eigen::Vector3d& s,
+                  const Eigen::Vector3d& d, double lever_tol) {
+  const double dz = d.cross(com - s).z(), lever = (com - s).norm();
+  return (dz <= 1e-3 * lever && !blocked(contacts, s, d, 1, lever_tol)) ||
+         (dz >= -1e-3 * lever && !blocked(contacts, s, d, -1, lever_tol));
+}
+
 // Highest area surface within `radius` of (x, y) in the height grid; -inf over nothing.
 double surfaceBelow(const HeightGrid& g, double x, double y, double radius) {
   const int r = static_cast<int>(std::ceil(radius / g.cell));
@@ -260,7 +269,7 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     // cylinder on its side turns about its line): tilt (Section V-C) about the point or the line.
     // (Accepting a band of contacts along a line as a support was tried: Bullet rolled every
     // such marker, its centre of mass not above the true line of contact.)
-    const bool line = axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear;
+    bool line = axis.layout == ContactLayout::kSingle || axis.layout == ContactLayout::kCollinear;
     const bool can_turn = n.depth < ctx_.max_rotations &&
                           n.turns < kMaxTurnsPerRotation * std::max(1, ctx_.max_rotations);
     // A line of contacts under the centre of mass: the object lies on a curved side (a
@@ -269,6 +278,10 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     // the bottom of its roll (rollStep) and holds there when a roll either way lifts it.
     const bool rolls = axis.layout == ContactLayout::kCollinear && s.com_inside && !s.hanging &&
                        std::abs(axis.d_A.z()) < kMaxRollAxisSlope;
+    // A line that does not roll, whose downhill turns its own contacts block (a rod's foot on a
+    // floor and its lean on a wall, a tenth of their length apart), is no hinge: the pose is
+    // judged as a support (it holds, or it slides: the local optimisation), not turned.
+    if (line && !rolls && !downhillTurn(n.contacts, com, axis.s_A, axis.d_A, 1.5 * cd)) line = false;
     if (line && rolls && n.roll == 1) {
       const bool holds = n.roll_margin >= ctx_.stability.min_tipping_angle;
       n.tipping_angle = n.roll_margin;

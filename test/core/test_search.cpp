@@ -86,6 +86,42 @@ std::vector<TreeLeaf> settle(const TreeContext& ctx, const Eigen::Isometry3d& X,
   return leaves;
 }
 
+// The leaning tests' area: a floor (top at z = 0), a wall with its face at x = 0.1 and a stop
+// 15 mm tall with its face at x = -0.07.
+Mesh wallAndStop() {
+  return scenes::merge({scenes::box(0.6, 0.3, 0.02, {0, 0, -0.01}), scenes::box(0.02, 0.3, 0.3, {0.11, 0, 0.15}),
+                        scenes::box(0.02, 0.3, 0.015, {-0.08, 0, 0.0075})},
+                       "wall and stop");
+}
+
+// `rod` leaning 35 degrees towards the wall: its top corner 5 mm off it, its foot 3 mm above
+// the floor.
+Eigen::Isometry3d leaningOnTheWall(const Mesh& rod) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(35 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  double xmax = -1, zmin = 1;
+  for (const auto& v : rod.vertices) {
+    xmax = std::max(xmax, (X.linear() * v).x());
+    zmin = std::min(zmin, (X.linear() * v).z());
+  }
+  X.translation() = Eigen::Vector3d(0.095 - xmax, 0, 0.003 - zmin);
+  return X;
+}
+
+// At X the rod's foot is on the floor against the stop, its top on the wall.
+void expectAgainstTheStop(const Mesh& rod, const Rigid& X) {
+  double lo = 1, hi = -1, low = 1;
+  for (const auto& v : rod.vertices) {
+    const V3 q = apply(X, toV3(v));
+    lo = std::min(lo, q.x);
+    hi = std::max(hi, q.x);
+    low = std::min(low, q.z);
+  }
+  EXPECT_NEAR(lo, -0.07, 0.004) << "its foot is not against the stop";
+  EXPECT_NEAR(hi, 0.1, 0.004) << "its top is not on the wall";
+  EXPECT_NEAR(low, 0.0, 0.004) << "its foot is not on the floor";
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------ resting faces (IV-A)
@@ -344,56 +380,19 @@ TEST(Robustness, BoxNearTheEdgeOfAWallTop) {
   EXPECT_LT(checkRobustness({X_GO}, ctx, p).front().held, 12);
 }
 
-// Rock settle (TreeContext::rock_settle, PlannerConfig::rock_settle): the mug standing on the
-// dish rack's domed peg tops, released tilted 3 degrees, lands propped on pegs a millimetre away
-// (within the contact tolerance) and the static test holds it there, 3 degrees off: without the
-// rock the tilted trials fail and the pose is not robust. Rocked about its centre of mass it
-// finds lower and comes back upright, so every trial holds.
 // A board leaning on a wall at 35 degrees from vertical slips at mu 0.2 (a ladder needs 67
 // degrees from the floor): its foot kicks out. The tree slides it away from the wall (Section
 // VI's slide), not tipping it over; with a low stop behind the foot it ends leaning, its foot
 // against the stop, its top on the wall (as a plate's foot meets a rack's peg row).
 TEST(Search, LeaningBoardSlidesToTheStopBehindItsFoot) {
   const Mesh rod = scenes::box(0.02, 0.12, 0.25);
-  Mesh area = scenes::box(0.6, 0.3, 0.02, {0, 0, -0.01});  // floor, top at z = 0
-  auto add = [&](const Mesh& m) {
-    std::vector<std::vector<int>> polys = area.patches;
-    std::vector<Eigen::Vector3d> v = area.vertices;
-    for (auto poly : m.patches) {
-      for (int& i : poly) i += static_cast<int>(area.vertices.size());
-      polys.push_back(poly);
-    }
-    v.insert(v.end(), m.vertices.begin(), m.vertices.end());
-    area = buildMesh(v, polys, "area");
-  };
-  add(scenes::box(0.02, 0.3, 0.3, {0.11, 0, 0.15}));     // the wall, its face at x = 0.1
-  add(scenes::box(0.02, 0.3, 0.015, {-0.08, 0, 0.0075}));  // the stop, its face at x = -0.07
-  TreeScene scene(rod, area, 0.0015, 0.00225, 0.2);
+  TreeScene scene(rod, wallAndStop(), 0.0015, 0.00225, 0.2);
   scene.ctx.rock_settle = true;  // the planner's default
-  const double lean = 35 * M_PI / 180;
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::AngleAxisd(lean, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  // Its top corner 5 mm off the wall, its foot 3 mm above the floor.
-  double xmax = -1, zmin = 1;
-  for (const auto& v : rod.vertices) {
-    xmax = std::max(xmax, (X.linear() * v).x());
-    zmin = std::min(zmin, (X.linear() * v).z());
-  }
-  X.translation() = Eigen::Vector3d(0.095 - xmax, 0, 0.003 - zmin);
-  const std::vector<TreeLeaf> leaves = settle(scene.ctx, X, scene.om.com, 0.1);
+  const std::vector<TreeLeaf> leaves = settle(scene.ctx, leaningOnTheWall(rod), scene.om.com, 0.1);
   ASSERT_EQ(leaves.size(), 1u);
   const TreeLeaf& l = leaves.front();
   ASSERT_TRUE(l.stable) << "the board did not come to rest against the stop";
-  double lo = 1, hi = -1, low = 1;
-  for (const auto& v : rod.vertices) {
-    const V3 q = apply(l.X_GO, toV3(v));
-    lo = std::min(lo, q.x);
-    hi = std::max(hi, q.x);
-    low = std::min(low, q.z);
-  }
-  EXPECT_NEAR(lo, -0.07, 0.004) << "its foot is not against the stop";
-  EXPECT_NEAR(hi, 0.1, 0.004) << "its top is not on the wall";
-  EXPECT_NEAR(low, 0.0, 0.004) << "its foot is not on the floor";
+  expectAgainstTheStop(rod, l.X_GO);
 }
 
 // The same with a rod 1 cm wide: its contacts at the foot and on the wall lie within a tenth
@@ -403,35 +402,14 @@ TEST(Search, LeaningBoardSlidesToTheStopBehindItsFoot) {
 // blocked and ended, not stable).
 TEST(Search, LeaningRodOnANarrowFootIsNoHinge) {
   const Mesh rod = scenes::box(0.01, 0.01, 0.25);
-  const Mesh area = scenes::merge({scenes::box(0.6, 0.3, 0.02, {0, 0, -0.01}), scenes::box(0.02, 0.3, 0.3, {0.11, 0, 0.15}),
-                                   scenes::box(0.02, 0.3, 0.015, {-0.08, 0, 0.0075})},
-                                  "wall and stop");
-  TreeScene scene(rod, area, 0.0015, 0.00225, 0.2);
+  TreeScene scene(rod, wallAndStop(), 0.0015, 0.00225, 0.2);
   scene.ctx.rock_settle = true;  // the planner's default
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::AngleAxisd(35 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  double xmax = -1, zmin = 1;
-  for (const auto& v : rod.vertices) {
-    xmax = std::max(xmax, (X.linear() * v).x());
-    zmin = std::min(zmin, (X.linear() * v).z());
-  }
-  X.translation() = Eigen::Vector3d(0.095 - xmax, 0, 0.003 - zmin);
-  const std::vector<TreeLeaf> leaves = settle(scene.ctx, X, scene.om.com, 0.1);
-  ASSERT_FALSE(leaves.empty());
+  const std::vector<TreeLeaf> leaves = settle(scene.ctx, leaningOnTheWall(rod), scene.om.com, 0.1);
   const TreeLeaf* rest = nullptr;
   for (const TreeLeaf& l : leaves)
     if (l.stable && !rest) rest = &l;
   ASSERT_NE(rest, nullptr) << "the rod did not come to rest between the wall and the stop";
-  double lo = 1, hi = -1, low = 1;
-  for (const auto& v : rod.vertices) {
-    const V3 q = apply(rest->X_GO, toV3(v));
-    lo = std::min(lo, q.x);
-    hi = std::max(hi, q.x);
-    low = std::min(low, q.z);
-  }
-  EXPECT_NEAR(lo, -0.07, 0.004) << "its foot is not against the stop";
-  EXPECT_NEAR(hi, 0.1, 0.004) << "its top is not on the wall";
-  EXPECT_NEAR(low, 0.0, 0.004) << "its foot is not on the floor";
+  expectAgainstTheStop(rod, rest->X_GO);
 }
 
 // A ring (torus, axis along y) dropped over a horizontal square peg with its centre 1 cm to
@@ -473,6 +451,11 @@ TEST(Search, RingSwingsToHangBelowAPeg) {
   for (const TreeLeaf& b : settle(scene.ctx, X, scene.om.com, 0.05)) EXPECT_FALSE(b.stable);
 }
 
+// Rock settle (TreeContext::rock_settle, PlannerConfig::rock_settle): the mug standing on the
+// dish rack's domed peg tops, released tilted 3 degrees, lands propped on pegs a millimetre away
+// (within the contact tolerance) and the static test holds it there, 3 degrees off: without the
+// rock the tilted trials fail and the pose is not robust. Rocked about its centre of mass it
+// finds lower and comes back upright, so every trial holds.
 TEST(Robustness, MugTiltedOnPegTopsRocksBackUpright) {
   PP_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");

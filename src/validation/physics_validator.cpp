@@ -213,17 +213,19 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
     for (int t : group) n += area[t] * normal[t];
     n = n.norm() > 1e-12 ? Eigen::Vector3d(n.normalized()) : normal[seed];
     // Thickness: piece_thickness, less where the opposite surface is closer (thin walls, the
-    // marker's 2 cm body) so that the piece does not poke out on the other side.
-    double depth = std::numeric_limits<double>::infinity();
-    for (int t : group)
-      for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3d& p = m.vertices[m.triangles[t][k]];
-        const Eigen::Vector3d start = p - 1e-6 * n;
-        depth = std::min(depth, rayDepth(m, start, -n, grid.near(start, start - reach * n), group));
-      }
+    // marker's 2 cm body) so that the piece does not poke out on the other side; a piece facing
+    // along piece_full_depth_along keeps it all (no depth rays cast).
     const bool full = c.piece_full_depth_along.norm() > 0 &&
                       n.dot(c.piece_full_depth_along.normalized()) > std::cos(M_PI / 4);
-    const double thickness = full ? c.piece_thickness : std::min(depth, c.piece_thickness);
+    double depth = std::numeric_limits<double>::infinity();
+    if (!full)
+      for (int t : group)
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d& p = m.vertices[m.triangles[t][k]];
+          const Eigen::Vector3d start = p - 1e-6 * n;
+          depth = std::min(depth, rayDepth(m, start, -n, grid.near(start, start - reach * n), group));
+        }
+    const double thickness = std::min(depth, c.piece_thickness);
     // The hull is shrunk by both margins (object's and area's) below, but Bullet shrinks a hull
     // by at most kShrinkClamp of its inner radius (about half a slab's thickness): a thin slab
     // keeps most of the margins, and a mug's 1.5 mm bottom rested 5-7 mm above the table (with

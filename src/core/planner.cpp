@@ -117,6 +117,12 @@ std::vector<V3> findFloorPoints(const AreaModel& am, const PlannerConfig& config
   return orderFloorPoints(kept, fp.spacing);
 }
 
+// Sideways penetration allowed, in sphere radii: the contact distance of the object's spheres
+// against the area's (1.5 r, area_model_cache.h, before its rounding). The swing lowers an
+// object along gravity only, so against a wall it settles within that band of the wall, not
+// on it (penetration.h; measured on the hanging suites, doc/method.md).
+constexpr double kSidewaysPenetration = 2.5;
+
 // What the tree steps need (Sections V, VI): models, backend, stability parameters.
 TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaModel& am, Backend& backend,
                         const Radii& rad, const PlannerConfig& config, PlanStats& st, bool scanned) {
@@ -130,6 +136,7 @@ TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaMod
   ctx.rock_settle = config.rock_settle;
   ctx.shape_uncertainty = scanned ? config.scan_noise : 0.0;  // a scan's crests are its noise's
   ctx.penetration_limit = rad.r;  // as the result's guard (SearchMonitor::afterStep)
+  ctx.penetration_sideways = kSidewaysPenetration * rad.r;
   return ctx;
 }
 
@@ -227,7 +234,7 @@ struct SearchMonitor {
   const PlannerConfig& config;
   const ProgressCallback& progress;
   Clock::time_point t0;
-  double search_budget, penetration_limit;
+  double search_budget, penetration_limit, penetration_sideways;
   int orientations;
   int hanging;  // roots before the floor points' (root_search.h)
   std::function<std::vector<Robustness>(const std::vector<size_t>&)> robustness;
@@ -247,14 +254,16 @@ struct SearchMonitor {
 
   bool afterStep(std::vector<TreeLeaf>& all, int started, int open) {
     PlanStats& st = result.stats;
-    // Penetration guard: an object inside the area by more than a sphere radius is not stable
-    // (the new stable leaves tested on the pool).
+    // Penetration guard: an object inside the area by more than a sphere radius below a
+    // surface, or by more than 2.5 radii (the contact distance) in a wall or a post, is not
+    // stable (the new stable leaves tested on the pool; penetration.h, kSidewaysPenetration).
     std::vector<size_t> fresh;
     for (; seen < all.size(); ++seen)
       if (all[seen].stable) fresh.push_back(seen);
     std::vector<char> inside(fresh.size(), 0);
     parallelFor(fresh.size(), config.threads, [&](size_t k) {
-      inside[k] = penetrationDepth(om, am, all[fresh[k]].X_GO) > penetration_limit;
+      const Penetration p = penetration(om, am, all[fresh[k]].X_GO);
+      inside[k] = p.below > penetration_limit || p.depth > penetration_sideways;
     });
     for (size_t k = 0; k < fresh.size(); ++k)
       if (inside[k]) all[fresh[k]].stable = false;
@@ -469,7 +478,7 @@ class TreeSearch {
         // With the robustness check on, the search leaves a share of the budget for it.
         monitor_{m.om, *m.am, run.config, run.progress, run.t0,
                  run.budget * (run.config.robust_check ? kSearchShareOfBudget : 1.0), m.rad.r,
-                 static_cast<int>(r.orientations.size()), static_cast<int>(r.hanging.size()),
+                 kSidewaysPenetration * m.rad.r, static_cast<int>(r.orientations.size()), static_cast<int>(r.hanging.size()),
                  [this](const std::vector<size_t>& idx) { return robustness(idx); }, run.result, {}, 0, 1, 0.0, 0} {
     run.st().roots_total = roots_.size();
   }

@@ -5,11 +5,13 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "place_planner/infra/mesh_io.h"
 #include "place_planner/infra/scenes.h"
 #include "place_planner/model/scene.h"
 #include "place_planner/planner.h"
 #include "place_planner/search/loops.h"
 #include "place_planner/search/pegs.h"
+#include "test_helpers.h"
 
 namespace place_planner {
 namespace {
@@ -166,6 +168,43 @@ TEST(Placement, KindChoosesStandingOrHanging) {
   ASSERT_GT(table_any.stableCount(), 0);
   EXPECT_TRUE(table_any.candidates.front().X_WO.isApprox(table_standing.candidates.front().X_WO, 1e-9));
   EXPECT_THROW(placementKindFromString("dangling"), std::invalid_argument);
+}
+
+// A mug hung on a mug tree whose arms rise 35 degrees slides down its arm until its body meets
+// the trunk, and its swing then presses the body sideways against the trunk. Lowered straight
+// down after each turn, the swing cannot feel the trunk (straight up from inside a post is its
+// top, far off): the YCB mug ended 5 mm inside it, and the validator's engine threw it 1 cm up
+// the arm. The swing's moves and the result guard look sideways too (penetration.h).
+TEST(Placement, AMugHungBesideATreesTrunkStaysOutOfIt) {
+  PP_REQUIRE_SHARED_DATA();
+  const double trunk_r = 0.014;
+  std::vector<Mesh> parts{scenes::cylinder(0.11, 0.02), transformed(scenes::cylinder(trunk_r, 0.41, 24),
+                                                                     Eigen::Matrix3d::Identity(), {0, 0, 0.215})};
+  for (int k = 0; k < 6; ++k) {
+    const double yaw = k * M_PI / 3, z = std::array<double, 3>{0.22, 0.29, 0.36}[k % 3];
+    const Eigen::Vector3d d(std::cos(yaw) * std::cos(35 * M_PI / 180), std::sin(yaw) * std::cos(35 * M_PI / 180),
+                            std::sin(35 * M_PI / 180));
+    const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), d).toRotationMatrix();
+    parts.push_back(transformed(scenes::cylinder(0.006, 0.08, 16), R, Eigen::Vector3d(0, 0, z) + 0.05 * d));
+  }
+  const Mesh tree = scenes::merge(parts, "mug_tree_six");
+  const Mesh mug = loadMesh(test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  PlannerConfig c;
+  c.threads = 2;
+  c.placement = PlacementKind::kHanging;
+  const PlanResult r = Planner().plan(mug, tree, c);
+  ASSERT_GT(r.stableCount(), 0);
+  for (const Candidate& k : r.candidates) {
+    if (!k.stable) continue;
+    EXPECT_TRUE(k.hanging);
+    // No vertex of the mug deeper in the trunk than the planner's contact distance (3.75 mm).
+    double deepest = 0;
+    for (const Eigen::Vector3d& v : mug.vertices) {
+      const Eigen::Vector3d p = k.X_WO * v;
+      if (p.z() > 0.02 && p.z() < 0.42) deepest = std::max(deepest, trunk_r - p.head<2>().norm());
+    }
+    EXPECT_LT(deepest, 0.004) << "at " << k.X_WO.translation().transpose();
+  }
 }
 
 }  // namespace

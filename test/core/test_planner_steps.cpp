@@ -462,6 +462,25 @@ TEST(Penetration, DepthAlongTheSurfaceNormal) {
   }
 }
 
+// A vertex inside a vertical post is seen by the sideways rays: straight up it meets the post's
+// top far above (an overhang to the upward ray alone), which a swing into a mug tree's trunk
+// would otherwise pass.
+TEST(Penetration, InsideAVerticalPost) {
+  const Mesh post = scenes::box(0.03, 0.03, 0.40, {0, 0, 0.20});
+  const AreaModel am = buildAreaModel(post, {0, 0, -1}, 0.002, 0.0035, 0.0035);
+  const ObjectModel om = buildObjectModel(scenes::box(0.004, 0.004, 0.004), 0.0005);
+  for (double inside : {0.001, 0.004}) {
+    // The cube's side 2 mm from its centre, `inside` past the post's +x face, 20 cm up.
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.translation() = Eigen::Vector3d(0.015 + 0.002 - inside, 0, 0.2);
+    EXPECT_NEAR(penetrationDepth(om, am, toRigid(X)), inside, 1e-4) << inside;
+  }
+  // Beside the post, clear of it: none.
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(0.015 + 0.003, 0, 0.2);
+  EXPECT_EQ(penetrationDepth(om, am, toRigid(X)), 0.0);
+}
+
 TEST(Ranking, TheLargerTippingMarginRanksFirstAmongEqualPoses) {
   // Two stable poses of a 10 cm cube on a flat top, alike in Q, contacts and robust share; one
   // tips off after 2 degrees of tilt, the other after 8. The tie-break alone (nearer the frame's

@@ -4,13 +4,24 @@
 
 namespace place_planner {
 
-// Deepest object vertex below an area surface it is inside of: a ray from the vertex against
-// gravity that first meets an area triangle from its back (the triangle's normal points along
-// the ray) is inside that surface, by the hit distance times the normal's vertical part (the
-// depth along the surface's normal). Hits farther than `max_depth` are
-// taken as another surface above (an overhang), not penetration. Assumes the area's patch
-// normals point out of its solid parts, as in reconstructed and CAD meshes.
+// Deepest object vertex inside the area: a ray from the vertex (against gravity, and along the
+// four horizontal axes of G) that first meets an area triangle from its back (the triangle's
+// normal points along the ray) starts inside that surface, by the hit distance times the
+// normal's part along the ray (the depth along the surface's normal); a vertex's depth is the
+// least over its rays that start inside (inside a vertical post only the sideways rays see it).
+// Hits farther than `max_depth` are taken as another surface (an overhang), not penetration.
+// Assumes the area's patch normals point out of its solid parts, as in reconstructed and CAD
+// meshes.
 double penetrationDepth(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
+                        double max_depth = 0.03);
+
+// The same (depth), and the deepest below a surface straight above (the upward rays alone:
+// the guard's measure before the sideways rays, still held to a sphere radius).
+struct Penetration {
+  double depth = 0;
+  double below = 0;
+};
+Penetration penetration(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
                         double max_depth = 0.03);
 
 }  // namespace place_planner

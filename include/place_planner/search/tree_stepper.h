@@ -100,9 +100,11 @@ struct TreeContext {
   // roll holds only when its crests rise more than this too (rollStep): a crest the noise could
   // have made, or flattened, is no evidence of a rest. 0: the mesh is taken as exact.
   double shape_uncertainty = 0;
-  // A swing's move that leaves the object deeper than this in the area (penetration.h) is not
-  // taken (m); the planner's result guard uses the same depth. 0: not checked.
+  // A swing's move that leaves the object deeper than this below a surface straight above it,
+  // or deeper than penetration_sideways in any surface (a wall, a post: penetration.h), is not
+  // taken (m); the planner's result guard uses the same depths. 0: that one not checked.
   double penetration_limit = 0;
+  double penetration_sideways = 0;
 };
 
 class TreeStepper {

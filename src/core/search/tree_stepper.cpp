@@ -439,15 +439,18 @@ void TreeStepper::swingStep() {
       if (k == kMoves - 1 && n.settle_v.squaredNorm() + n.settle_w.squaredNorm() == 0) h[k] = kInf;
     }
     // The lowest move that leaves the object out of the area: lowered straight down, a turn can
-    // still push it sideways into a wall (a ring into the board behind its peg), which the
-    // result's penetration guard would then reject; the next lowest is taken instead.
+    // still push it sideways into a wall (a ring into the board behind its peg, a mug into a
+    // mug tree's trunk, which only a sideways ray sees), which the result's penetration guard
+    // would then reject; the next lowest is taken instead.
     for (int tries = 0; tries < kMoves; ++tries) {
       best = 0;
       for (int k = 1; k < kMoves; ++k)
         if (h[k] < h[best]) best = k;
       if (best == 0 || ctx_.penetration_limit <= 0 || h[best] >= h[0] - kSwingDrop) break;
       const Rigid Y = translated(q[i0 + best].X_GO, v3(0, 0, -d[i0 + best]));
-      if (penetrationDepth(ctx_.om, ctx_.am, Y) <= ctx_.penetration_limit) break;
+      const Penetration pen = penetration(ctx_.om, ctx_.am, Y);
+      if (pen.below <= ctx_.penetration_limit && (ctx_.penetration_sideways <= 0 || pen.depth <= ctx_.penetration_sideways))
+        break;
       h[best] = kInf;
     }
     ++n.swings;

@@ -478,7 +478,8 @@ class TreeSearch {
         // With the robustness check on, the search leaves a share of the budget for it.
         monitor_{m.om, *m.am, run.config, run.progress, run.t0,
                  run.budget * (run.config.robust_check ? kSearchShareOfBudget : 1.0), m.rad.r,
-                 kSidewaysPenetration * m.rad.r, static_cast<int>(r.orientations.size()), static_cast<int>(r.hanging.size()),
+                 kSidewaysPenetration * m.rad.r, static_cast<int>(r.orientations.size()),
+                 static_cast<int>(r.hanging.size()),
                  [this](const std::vector<size_t>& idx) { return robustness(idx); }, run.result, {}, 0, 1, 0.0, 0} {
     run.st().roots_total = roots_.size();
   }

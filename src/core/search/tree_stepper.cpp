@@ -449,8 +449,8 @@ void TreeStepper::swingStep() {
       if (best == 0 || ctx_.penetration_limit <= 0 || h[best] >= h[0] - kSwingDrop) break;
       const Rigid Y = translated(q[i0 + best].X_GO, v3(0, 0, -d[i0 + best]));
       const Penetration pen = penetration(ctx_.om, ctx_.am, Y);
-      if (pen.below <= ctx_.penetration_limit && (ctx_.penetration_sideways <= 0 || pen.depth <= ctx_.penetration_sideways))
-        break;
+      const bool sideways_ok = ctx_.penetration_sideways <= 0 || pen.depth <= ctx_.penetration_sideways;
+      if (pen.below <= ctx_.penetration_limit && sideways_ok) break;
       h[best] = kInf;
     }
     ++n.swings;

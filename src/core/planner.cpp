@@ -262,8 +262,7 @@ struct SearchMonitor {
       if (all[seen].stable) fresh.push_back(seen);
     std::vector<char> inside(fresh.size(), 0);
     parallelFor(fresh.size(), config.threads, [&](size_t k) {
-      const Penetration p = penetration(om, am, all[fresh[k]].X_GO);
-      inside[k] = p.below > penetration_limit || p.depth > penetration_sideways;
+      inside[k] = !penetration(om, am, all[fresh[k]].X_GO).within(penetration_limit, penetration_sideways);
     });
     for (size_t k = 0; k < fresh.size(); ++k)
       if (inside[k]) all[fresh[k]].stable = false;

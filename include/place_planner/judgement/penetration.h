@@ -20,6 +20,11 @@ double penetrationDepth(const ObjectModel& object, const AreaModel& area, const 
 struct Penetration {
   double depth = 0;
   double below = 0;
+  // The guard's rule (the planner's result and the swing's moves): at most below_limit below a
+  // surface and sideways_limit in any (0: not checked).
+  bool within(double below_limit, double sideways_limit) const {
+    return below <= below_limit && (sideways_limit <= 0 || depth <= sideways_limit);
+  }
 };
 Penetration penetration(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
                         double max_depth = 0.03);

@@ -113,13 +113,18 @@ bool blocked(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& s
   return false;
 }
 
+// Whether a turn about the axis (s, d), `sign` 1 counter-clockwise or -1, raises the centre of
+// mass com: gravity cannot tip a free object that way (tiltStep does not follow it).
+bool raises(const Eigen::Vector3d& com, const Eigen::Vector3d& s, const Eigen::Vector3d& d, int sign) {
+  return sign * d.cross(com - s).z() > 1e-3 * (com - s).norm();  // d(com.z)/d(angle), signed
+}
+
 // Whether a turn about the axis (s, d) that does not raise the centre of mass com is free of
 // the contacts (tiltStep's limits: the uphill turn is not followed, a blocked one not searched).
 bool downhillTurn(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com, const Eigen::Vector3d& s,
                   const Eigen::Vector3d& d, double lever_tol) {
-  const double dz = d.cross(com - s).z(), lever = (com - s).norm();
-  return (dz <= 1e-3 * lever && !blocked(contacts, s, d, 1, lever_tol)) ||
-         (dz >= -1e-3 * lever && !blocked(contacts, s, d, -1, lever_tol));
+  return (!raises(com, s, d, 1) && !blocked(contacts, s, d, 1, lever_tol)) ||
+         (!raises(com, s, d, -1) && !blocked(contacts, s, d, -1, lever_tol));
 }
 
 // Highest area surface within `radius` of (x, y) in the height grid; -inf over nothing.
@@ -448,9 +453,7 @@ void TreeStepper::swingStep() {
         if (h[k] < h[best]) best = k;
       if (best == 0 || ctx_.penetration_limit <= 0 || h[best] >= h[0] - kSwingDrop) break;
       const Rigid Y = translated(q[i0 + best].X_GO, v3(0, 0, -d[i0 + best]));
-      const Penetration pen = penetration(ctx_.om, ctx_.am, Y);
-      const bool sideways_ok = ctx_.penetration_sideways <= 0 || pen.depth <= ctx_.penetration_sideways;
-      if (pen.below <= ctx_.penetration_limit && sideways_ok) break;
+      if (penetration(ctx_.om, ctx_.am, Y).within(ctx_.penetration_limit, ctx_.penetration_sideways)) break;
       h[best] = kInf;
     }
     ++n.swings;
@@ -486,13 +489,12 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
     // gravity cannot tip a free object the other way, and the cut keeps the tree linear in
     // the number of rotations instead of exponential.
     const Eigen::Vector3d c = toEigen(apply(n.X_GO, n.com_O));
-    const double dz = n.d_A.cross(c - n.s_A).z();  // d(com.z)/d(angle) for +rotation
-    const double lever = (c - n.s_A).norm();
-    if (!n.local_rotation && dz > 1e-3 * lever) rq.limit_ccw = 0;
-    if (!n.local_rotation && dz < -1e-3 * lever) rq.limit_cw = 0;
+    const bool up_ccw = raises(c, n.s_A, n.d_A, 1), up_cw = raises(c, n.s_A, n.d_A, -1);
+    if (!n.local_rotation && up_ccw) rq.limit_ccw = 0;
+    if (!n.local_rotation && up_cw) rq.limit_cw = 0;
     // Neutral (the centre of mass above the axis: a cylinder on its side, a ball): after the
     // first turn of a tree only one way is followed, so rolling costs a path, not a tree.
-    if (!n.local_rotation && std::abs(dz) <= 1e-3 * lever && n.turns > 0) rq.limit_cw = 0;
+    if (!n.local_rotation && !up_ccw && !up_cw && n.turns > 0) rq.limit_cw = 0;
     // A tilt ends where gravity can no longer carry it about this axis: once the centre of
     // mass has dropped below the axis (its lever past horizontal) the object slides or falls off
     // the pivot rather than keep turning on it. So the search covers the lever's elevation plus

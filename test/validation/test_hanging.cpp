@@ -236,6 +236,44 @@ TEST(Hanging, YcbMugIsLiftedOverACupHooksTipAndHangsOnItsArm) {
   expectStillHangsInBullet(mug, hooks, *best);
 }
 
+// A rod of radius r from a to b (a cylinder along z, centred, turned and moved there).
+Mesh rod(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r) {
+  Mesh c = scenes::cylinder(r, (b - a).norm(), 12);
+  const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), b - a).toRotationMatrix();
+  for (Eigen::Vector3d& v : c.vertices) v = R * v + 0.5 * (a + b);
+  return buildMesh(c.vertices, c.patches, "rod");
+}
+
+// Cup hooks whose tip turns up 2.5 cm (not in the suite; the suite's turn up 1 cm): a stem 7 cm
+// down from a shelf board, an arm 4 cm out, 6 mm wire. The tip with the arm under it stands 3.1
+// cm; the YCB mug's handle, turned as it hangs, leaves 2.4 cm over the arm (its largest circle):
+// it cannot pass over the tip that way. Turned a quarter about the arm, the handle's long side
+// upright, it passes over, comes down on the arm and swings to its rest. (Without the turned
+// starts: no threaded start, no stable pose.)
+TEST(Hanging, YcbMugTurnsItsHandleUprightToPassOverATallHookTip) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  std::vector<Mesh> parts{scenes::box(0.6, 0.2, 0.02, {0, 0, 0.41})};
+  for (const double x : {-0.2, 0.0, 0.2}) {
+    parts.push_back(rod({x, 0, 0.33}, {x, 0, 0.403}, 0.003));
+    parts.push_back(rod({x, 0.003, 0.33}, {x, -0.038, 0.33}, 0.003));
+    parts.push_back(rod({x, -0.035, 0.33}, {x, -0.035, 0.355}, 0.003));
+  }
+  const Mesh hooks = scenes::merge(parts, "tall_tip_hooks");
+  const std::optional<Candidate> best = bestHung(mug, hooks);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
+  EXPECT_GT(best->placement.approach.direction.y(), 0.95) << "not threaded along the arm from its tip";
+  EXPECT_GT(best->placement.pre_place_W.translation().z(), best->X_WO.translation().z() + 0.003)
+      << "not lifted over the tip";
+  const Eigen::Vector3d com = best->X_WO * mug.properties.center_of_mass;
+  int on_arm = 0;
+  for (const ContactPoint& p : best->contacts)
+    on_arm += p.p_W.z() > com.z() + 0.01 && std::abs(p.p_W.z() - 0.33) < 0.006 && p.p_W.y() < 0 && p.p_W.y() > -0.045;
+  EXPECT_GT(on_arm, 0) << "it does not hang from a hook's arm";
+  expectStillHangsInBullet(mug, hooks, *best);
+}
+
 // A board 12 cm tall with three 10 mm pegs 8 cm long rising 10 degrees (not in the suite).
 Mesh shortBoardOfRisingPegs() {
   std::vector<Mesh> parts{scenes::box(0.5, 0.02, 0.12, {0, 0.01, 0.4})};

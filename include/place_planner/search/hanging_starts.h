@@ -25,7 +25,10 @@ struct HangingStart {
 // enough along the peg that the object clears the peg's base (or, where it reaches back past
 // the room, at the far end only), centred on the peg, off it a little or lifted over a tip that
 // turns up. Kept when the object's sphere model sweeps along the peg from beyond its tip to
-// that pose without touching the area (the first free of each peg, loop and way round). On a
+// that pose without touching the area (the first free of each peg, loop and way round). Where
+// none is, the same turned a quarter about the peg either way and lifted by up to four times the
+// loop's room (an opening longer than its largest circle passes a tall turned-up tip upright),
+// kept when the object also meets the peg moving up and moving down from it (round it). On a
 // peg rising more than half the friction angle atan(friction) / 2 it is then slid down the peg
 // to its first contact there (the wall, a post), where it would come to rest.
 std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,

@@ -1,6 +1,7 @@
 // Hanging roots (hanging_starts.h).
 #include "place_planner/search/hanging_starts.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -19,7 +20,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   std::vector<HangingStart> starts;
   std::vector<TranslationQuery> sweeps;
   std::vector<int> group;          // per start: its peg, loop and way round
-  std::vector<char> off_centre;    // per start: the loop's centre off the peg's axis
+  std::vector<char> phase_of;    // per start: its phase (0 centred, 1 off the axis, 2 rolled)
   int groups = 0;
   const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d com_O = toEigen(om.com);
@@ -37,75 +38,90 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         Eigen::Matrix3d from, to;
         from << loop.axis, below, loop.axis.cross(below);
         to << sign * peg.axis, hang, (sign * peg.axis).cross(hang);
-        const Eigen::Matrix3d R = to * from.transpose();
-        // How far the object reaches from the loop's centre towards the base and towards the tip.
-        double back = 0, front = 0;
-        for (const V3& v : om.vertices) {
-          const double s = (R * (toEigen(v) - loop.centre)).dot(peg.axis);
-          back = std::max(back, -s);
-          front = std::max(front, s);
-        }
-        // Along the peg: in the middle of the room between the object clear of the base (by a
-        // collision distance and a millimetre) and the loop's far side short of the tip by half
-        // its thickness (at most 1 cm: a roll of tape's 5 cm need not be), so a swing or a push
-        // meets neither.
-        const double length = peg.to_base + peg.to_tip;
-        // Where the object reaches farther back than the peg is long (a mug's body below a cup
-        // hook's short arm), only the far end is tried: the sweep finds whether what hangs below
-        // the peg clears its base (a wall does not let it; a hook's stem above the arm does).
-        const double farthest = length - 0.5 * loop.thickness - std::min(0.5 * loop.thickness, 0.01);
-        const double nearest = std::min(back + cd + 0.001, farthest);
-        if (farthest <= 0) continue;
-        // Threaded to the middle of that room or, where the sweep finds the middle blocked (a
-        // wide loop on a steep arm meets the post behind it), to its far end: on a rising peg it
-        // then slides to where it rests either way (below).
-        // Where a knob on the tip or a scan's rough loop leaves both blocked, the same with the
-        // loop's centre off the peg's axis by a third of the room round the peg, up, down and
-        // to either side (the loop's centre is found to a silhouette pixel); and lifted by all
-        // that room but a collision distance and a millimetre, the peg just inside the loop's
-        // bottom, so the opening passes over a tip that turns up (a cup hook), then lowered.
+        const Eigen::Matrix3d R_rest = to * from.transpose();
+        // The loop's room round the peg, by its largest circle.
         const double room = loop.radius - peg.half_width;
-        const double off = room / 3.0, lift = std::max(off, room - cd - 0.001);
-        const Eigen::Vector3d side = peg.axis.cross(hang);
-        const Eigen::Vector3d offsets[] = {Eigen::Vector3d::Zero(), off * hang, -off * hang, off * side, -off * side,
-                                           -lift * hang};
-        for (int k = 0; k < 12; ++k) {
-          if (k % 2 == 0 && nearest >= farthest) continue;  // the middle is the far end
-          if (k / 2 == 5 && lift <= off) continue;          // a loop too tight to lift: as off-centre up
-          const Eigen::Vector3d& o = offsets[k / 2];
-          const double along = k % 2 ? farthest : 0.5 * (nearest + farthest);
-          const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis + o;
-          Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-          X.linear() = R;
-          X.translation() = at - R * loop.centre;
-          HangingStart h;
-          h.X_GO = toRigid(X);
-          h.drop = 2 * om.bounding_radius;  // its first contact ends it (V-A), below the opening's top
-          h.approach = -peg.axis;
-          h.approach_distance = (length - along) + back + 0.01;
-          h.peg_point = at;
-          Eigen::Isometry3d pre = X;
-          pre.translation() += h.approach_distance * peg.axis;
-          sweeps.push_back(
-              TranslationQuery{toRigid(pre), toV3(h.approach), h.approach_distance + 0.01});
-          starts.push_back(h);
-          group.push_back(groups);
-          off_centre.push_back(k >= 2);
+        // Rolled a quarter turn either way about the peg (phase 2, only where the rest's own
+        // starts are all blocked): an opening longer one way than its largest circle (a mug's
+        // handle, 6 cm tall and 3 cm deep) passes over a tip that turns up (a J-hook's, a cup
+        // hook's) with that length upright, lifted by up to four times the circle's room; the
+        // swing then turns it to its rest about the peg.
+        for (const double roll : {0.0, 0.5 * M_PI, -0.5 * M_PI}) {
+          const Eigen::Matrix3d R = Eigen::AngleAxisd(roll, peg.axis).toRotationMatrix() * R_rest;
+          const char phase = roll == 0.0 ? 0 : 2;
+          // How far the object reaches from the loop's centre towards the base and towards the tip.
+          double back = 0, front = 0;
+          for (const V3& v : om.vertices) {
+            const double s = (R * (toEigen(v) - loop.centre)).dot(peg.axis);
+            back = std::max(back, -s);
+            front = std::max(front, s);
+          }
+          // Along the peg: in the middle of the room between the object clear of the base (by a
+          // collision distance and a millimetre) and the loop's far side short of the tip by half
+          // its thickness (at most 1 cm: a roll of tape's 5 cm need not be), so a swing or a push
+          // meets neither.
+          const double length = peg.to_base + peg.to_tip;
+          // Where the object reaches farther back than the peg is long (a mug's body below a cup
+          // hook's short arm), only the far end is tried: the sweep finds whether what hangs below
+          // the peg clears its base (a wall does not let it; a hook's stem above the arm does).
+          const double farthest = length - 0.5 * loop.thickness - std::min(0.5 * loop.thickness, 0.01);
+          const double nearest = std::min(back + cd + 0.001, farthest);
+          if (farthest <= 0) continue;
+          // Threaded to the middle of that room or, where the sweep finds the middle blocked (a
+          // wide loop on a steep arm meets the post behind it), to its far end: on a rising peg it
+          // then slides to where it rests either way (below).
+          // Where a knob on the tip or a scan's rough loop leaves both blocked, the same with the
+          // loop's centre off the peg's axis by a third of the room round the peg, up, down and
+          // to either side (the loop's centre is found to a silhouette pixel); and lifted by all
+          // that room but a collision distance and a millimetre, the peg just inside the loop's
+          // bottom, so the opening passes over a tip that turns up (a cup hook), then lowered.
+          const double off = room / 3.0, lift = std::max(off, room - cd - 0.001);
+          const Eigen::Vector3d side = peg.axis.cross(hang);
+          std::vector<Eigen::Vector3d> offsets;
+          if (phase == 0) {
+            offsets = {Eigen::Vector3d::Zero(), off * hang, -off * hang, off * side, -off * side, -lift * hang};
+            if (lift <= off) offsets.pop_back();  // a loop too tight to lift: as off-centre up
+          } else {
+            for (int k = 1; k <= 4; ++k) offsets.push_back(-(k * room - cd - 0.001) * hang);
+          }
+          for (size_t j = 0; j < 2 * offsets.size(); ++j) {
+            const bool far_end = j % 2;
+            if (!far_end && nearest >= farthest) continue;  // the middle is the far end
+            const Eigen::Vector3d& o = offsets[j / 2];
+            const double along = far_end ? farthest : 0.5 * (nearest + farthest);
+            const Eigen::Vector3d at = peg.point + (along - peg.to_base) * peg.axis + o;
+            Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+            X.linear() = R;
+            X.translation() = at - R * loop.centre;
+            HangingStart h;
+            h.X_GO = toRigid(X);
+            h.drop = 2 * om.bounding_radius;  // its first contact ends it (V-A), below the opening's top
+            h.approach = -peg.axis;
+            h.approach_distance = (length - along) + back + 0.01;
+            h.peg_point = at;
+            Eigen::Isometry3d pre = X;
+            pre.translation() += h.approach_distance * peg.axis;
+            sweeps.push_back(TranslationQuery{toRigid(pre), toV3(h.approach), h.approach_distance + 0.01});
+            starts.push_back(h);
+            group.push_back(groups);
+            phase_of.push_back(phase == 0 ? (j >= 2 ? 1 : 0) : 2);
+          }
         }
         ++groups;
       }
     }
   if (starts.empty()) return starts;
   // Threaded by the sweep: its first contact (V-A's distance kernel) is past the threaded pose.
-  // The centred starts are swept first, the off-centre ones only for what that left unthreaded.
+  // The centred starts are swept first, the off-centre ones only for what that left unthreaded,
+  // the ones turned a quarter about the peg only for what both left.
   std::vector<double> t(starts.size(), -1.0);  // -1: not swept
   auto isFree = [&](size_t i) { return t[i] >= starts[i].approach_distance + 1e-3; };
   std::vector<char> threaded(groups, 0);  // one start per peg, loop and way round: the first free
-  for (const char phase : {0, 1}) {
+  for (const char phase : {0, 1, 2}) {
     std::vector<TranslationQuery> batch;
     std::vector<size_t> which;
     for (size_t i = 0; i < starts.size(); ++i)
-      if (off_centre[i] == phase && !threaded[group[i]]) {
+      if (phase_of[i] == phase && !threaded[group[i]]) {
         batch.push_back(sweeps[i]);
         which.push_back(i);
       }
@@ -113,6 +129,22 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
     std::vector<double> tb;
     backend.distance(batch, tb);
     for (size_t j = 0; j < which.size(); ++j) t[which[j]] = tb[j];
+    if (phase == 2) {
+      // A rolled start lifted that far may pass over the whole object, not through its loop:
+      // threaded only when the object meets the peg both ways across it, up and down.
+      std::vector<TranslationQuery> ud;
+      std::vector<size_t> at;
+      for (size_t j = 0; j < which.size(); ++j)
+        if (isFree(which[j]))
+          for (const double dir : {1.0, -1.0}) {
+            ud.push_back(TranslationQuery{starts[which[j]].X_GO, v3(0, 0, dir), 2 * om.bounding_radius});
+            at.push_back(which[j]);
+          }
+      std::vector<double> tu;
+      if (!ud.empty()) backend.distance(ud, tu);
+      for (size_t k = 0; k < at.size(); ++k)
+        if (tu[k] >= 2 * om.bounding_radius) t[at[k]] = -1.0;  // open one way: not round the peg
+    }
     for (size_t i = 0; i < starts.size(); ++i)
       if (isFree(i)) threaded[group[i]] = 1;
   }

@@ -118,6 +118,7 @@ struct PlanStats {
   int loops = 0;                   // the object's loops (search/loops.h), when pegs were found
   int hanging_starts = 0;          // loop-on-peg roots threaded free
   int start_orientations = 0;
+  int spikes_flattened = 0;        // vertices of a scanned object moved onto their neighbours' plane (model/despike.h)
   int roll_bottoms = 0;            // leaves at the bottom of a roll (tree_stepper rollStep), stable or not
   int trees_without_rest = 0;      // trees cut by max_rotations before reaching a resting pose
   int trees_fallen = 0;            // trees cut while falling over a ledge (TreeContext::fall_tip)

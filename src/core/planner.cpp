@@ -17,6 +17,7 @@
 
 #include "place_planner/model/area_model_cache.h"
 #include "place_planner/model/completion.h"
+#include "place_planner/model/despike.h"
 #include "place_planner/model/area_up.h"
 #include "place_planner/infra/backend.h"
 #include "place_planner/infra/cuda_backend.h"
@@ -590,9 +591,13 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   validate(config);
   if (object.empty()) throw std::invalid_argument("object mesh is empty");
   if (area.empty()) throw std::invalid_argument("placement area mesh is empty");
-  // Unseen is not empty: open regions of a scanned object capped (model/completion.h).
-  const Completion completion = completeOpenRegions(object);
+  // Unseen is not empty: open regions of a scanned object capped (model/completion.h), after
+  // its noise spikes are flattened (model/despike.h; an open mesh is a scan).
+  int spikes = 0;
+  const Mesh scan = completeOpenRegions(object).completed() ? despiked(object, config.scan_noise, &spikes) : Mesh{};
+  const Completion completion = completeOpenRegions(spikes > 0 ? scan : object);
   PlanRun run(completion, area, config, progress);
+  run.result.stats.spikes_flattened = spikes;
   // ---- models (III, V-B)
   const std::optional<Models> models = buildModels(run, *cache_);
   if (!models) return stopped(run.result, run.t0);

@@ -240,6 +240,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
   j["floor_points_done"] = st.floor_points_done;
   j["tree_nodes"] = st.tree_nodes;
   j["trees_without_rest"] = st.trees_without_rest;  // cut by max_rotations while still tilting
+  j["spikes_flattened"] = st.spikes_flattened;      // noise spikes of a scanned object flattened
   j["roll_bottoms"] = st.roll_bottoms;              // leaves at the bottom of a roll
   j["trees_fallen"] = st.trees_fallen;              // cut while falling over a ledge
   j["backend"] = st.backend;

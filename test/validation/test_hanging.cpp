@@ -210,6 +210,22 @@ TEST(Hanging, AMugScannedFromAboveThreadsPastTheKnobOfTheMugRacksPeg) {
   expectStillHangsInBullet(mug, rack, best);
 }
 
+// On cup hooks whose arms run along -y from their stems at y = 0, at height arm_z, reach long:
+// threaded towards the stem (+y) from beyond the tip, its first pose above the goal (lifted over
+// the tip), a contact above the centre of mass on an arm, and Bullet keeps it hanging.
+void expectLiftedOverTheTipAndHungOnTheArm(const Mesh& object, const Mesh& hooks, const Candidate& best,
+                                           double arm_z, double reach) {
+  EXPECT_GT(best.placement.approach.direction.y(), 0.95) << "not threaded along the arm from its tip";
+  EXPECT_GT(best.placement.pre_place_W.translation().z(), best.X_WO.translation().z() + 0.003)
+      << "not lifted over the tip";
+  const Eigen::Vector3d com = best.X_WO * object.properties.center_of_mass;
+  int on_arm = 0;
+  for (const ContactPoint& p : best.contacts)
+    on_arm += p.p_W.z() > com.z() + 0.01 && std::abs(p.p_W.z() - arm_z) < 0.006 && p.p_W.y() < 0 && p.p_W.y() > -reach;
+  EXPECT_GT(on_arm, 0) << "it does not hang from a hook's arm";
+  expectStillHangsInBullet(object, hooks, best);
+}
+
 // Cup hooks under a shelf (J hooks: a stem down from the board, an arm out, a tip turned up 1
 // cm). The arm is free beyond both its ends (the stem is as thin as the arm), and the mug's
 // body reaches farther back than the 3.5 cm arm is long. Only the far end is threaded, lifted:
@@ -222,18 +238,9 @@ TEST(Hanging, YcbMugIsLiftedOverACupHooksTipAndHangsOnItsArm) {
   const std::optional<Candidate> best = bestHung(mug, hooks);
   ASSERT_TRUE(best);
   EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
-  // Threaded towards the stem (+y) from beyond the tip, first pose above the goal (lifted).
-  EXPECT_GT(best->placement.approach.direction.y(), 0.95) << "not threaded along the arm from its tip";
   ASSERT_FALSE(best->intermediate_poses.empty());
   EXPECT_LT(best->placement.pre_place_W.translation().y(), -0.05) << "the approach does not start past the tip";
-  EXPECT_GT(best->placement.pre_place_W.translation().z(), best->X_WO.translation().z() + 0.003)
-      << "not lifted over the tip";
-  const Eigen::Vector3d com = best->X_WO * mug.properties.center_of_mass;
-  int on_arm = 0;
-  for (const ContactPoint& p : best->contacts)
-    on_arm += p.p_W.z() > com.z() + 0.01 && std::abs(p.p_W.z() - 0.35) < 0.006 && p.p_W.y() < 0 && p.p_W.y() > -0.04;
-  EXPECT_GT(on_arm, 0) << "it does not hang from a hook's arm";
-  expectStillHangsInBullet(mug, hooks, *best);
+  expectLiftedOverTheTipAndHungOnTheArm(mug, hooks, *best, 0.35, 0.04);
 }
 
 // A rod of radius r from a to b (a cylinder along z, centred, turned and moved there).
@@ -263,15 +270,7 @@ TEST(Hanging, YcbMugTurnsItsHandleUprightToPassOverATallHookTip) {
   const std::optional<Candidate> best = bestHung(mug, hooks);
   ASSERT_TRUE(best);
   EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
-  EXPECT_GT(best->placement.approach.direction.y(), 0.95) << "not threaded along the arm from its tip";
-  EXPECT_GT(best->placement.pre_place_W.translation().z(), best->X_WO.translation().z() + 0.003)
-      << "not lifted over the tip";
-  const Eigen::Vector3d com = best->X_WO * mug.properties.center_of_mass;
-  int on_arm = 0;
-  for (const ContactPoint& p : best->contacts)
-    on_arm += p.p_W.z() > com.z() + 0.01 && std::abs(p.p_W.z() - 0.33) < 0.006 && p.p_W.y() < 0 && p.p_W.y() > -0.045;
-  EXPECT_GT(on_arm, 0) << "it does not hang from a hook's arm";
-  expectStillHangsInBullet(mug, hooks, *best);
+  expectLiftedOverTheTipAndHungOnTheArm(mug, hooks, *best, 0.33, 0.045);
 }
 
 // A board 12 cm tall with three 10 mm pegs 8 cm long rising 10 degrees (not in the suite).

@@ -594,8 +594,12 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // Unseen is not empty: open regions of a scanned object capped (model/completion.h), after
   // its noise spikes are flattened (model/despike.h; an open mesh is a scan).
   int spikes = 0;
-  const Mesh scan = completeOpenRegions(object).completed() ? despiked(object, config.scan_noise, &spikes) : Mesh{};
-  const Completion completion = completeOpenRegions(spikes > 0 ? scan : object);
+  Mesh scan;  // outlives the completion, which refers to it when it was despiked
+  Completion completion = completeOpenRegions(object);
+  if (completion.completed()) {
+    scan = despiked(object, config.scan_noise, &spikes);
+    if (spikes > 0) completion = completeOpenRegions(scan);
+  }
   PlanRun run(completion, area, config, progress);
   run.result.stats.spikes_flattened = spikes;
   // ---- models (III, V-B)

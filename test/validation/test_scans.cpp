@@ -182,7 +182,7 @@ TEST(ScansShared, ANoiseSpikeUnderAScannedBottleIsFlattenedAndItStandsLevel) {
   const Mesh mustard = loadMesh(d + "/objects/mustard_ycb006.ply");
   const Mesh table = loadMesh(d + "/areas/table.ply");
   // The bottom vertex (within 2 mm of the lowest) whose neighbours lie flattest, 1 cm or more in
-  // from the bottom's edge (on the bottle's footprint, x in [-0.04, 0.03], y in [-0.05, 0]).
+  // from the bottom's edge (the bottle's footprint: x in [-0.04, 0.03], y in [-0.05, 0]).
   std::vector<std::vector<int>> ring(scan.vertices.size());
   for (const auto& t : scan.triangles)
     for (int k = 0; k < 3; ++k) ring[t[k]].insert(ring[t[k]].end(), {t[(k + 1) % 3], t[(k + 2) % 3]});

@@ -20,7 +20,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   std::vector<HangingStart> starts;
   std::vector<TranslationQuery> sweeps;
   std::vector<int> group;          // per start: its peg, loop and way round
-  std::vector<char> phase_of;    // per start: its phase (0 centred, 1 off the axis, 2 rolled)
+  std::vector<char> phase_of;      // per start: its phase (0 centred, 1 off the axis, 2 rolled)
   int groups = 0;
   const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d com_O = toEigen(om.com);
@@ -49,13 +49,9 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         for (const double roll : {0.0, 0.5 * M_PI, -0.5 * M_PI}) {
           const Eigen::Matrix3d R = Eigen::AngleAxisd(roll, peg.axis).toRotationMatrix() * R_rest;
           const char phase = roll == 0.0 ? 0 : 2;
-          // How far the object reaches from the loop's centre towards the base and towards the tip.
-          double back = 0, front = 0;
-          for (const V3& v : om.vertices) {
-            const double s = (R * (toEigen(v) - loop.centre)).dot(peg.axis);
-            back = std::max(back, -s);
-            front = std::max(front, s);
-          }
+          // How far the object reaches from the loop's centre towards the base.
+          double back = 0;
+          for (const V3& v : om.vertices) back = std::max(back, -(R * (toEigen(v) - loop.centre)).dot(peg.axis));
           // Along the peg: in the middle of the room between the object clear of the base (by a
           // collision distance and a millimetre) and the loop's far side short of the tip by half
           // its thickness (at most 1 cm: a roll of tape's 5 cm need not be), so a swing or a push

@@ -554,6 +554,7 @@ class TreeSearch {
       const TreeLeaf& l = leaves_[i];
       X.push_back(l.X_GO);
       pegs.push_back(l.peg);
+      pegs.back().swing_first = false;  // released at its rest
       Eigen::Vector3d c = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
       if (l.hanging && !l.contacts.empty()) {
         // The peg's contacts, not a wall's it leans on below (stability.cpp).

@@ -273,6 +273,35 @@ TEST(Hanging, YcbMugTurnsItsHandleUprightToPassOverATallHookTip) {
   expectLiftedOverTheTipAndHungOnTheArm(mug, hooks, *best, 0.33, 0.045);
 }
 
+// Two J-hooks of 6 mm wire on a wall (not in the suite): out 5 cm rising 10 degrees, the tip
+// turned up 2 cm. Its handle over the arm, the YCB mug's body (8 cm across) beside the handle
+// meets the wall before the handle is past the tip, rolled upright or not; turned 35 degrees
+// about the vertical as well, the body swings out from the wall, the handle passes the tip,
+// and the swing brings the mug to its rest below the arm. (Without the turned starts: no
+// threaded start, no stable pose.)
+TEST(Hanging, YcbMugTurnsItsBodyOutFromTheWallToPassAShortJHooksTip) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const double rise = 10 * M_PI / 180;
+  std::vector<Mesh> parts{scenes::box(0.6, 0.02, 0.6, {0, 0.01, 0.3})};
+  for (const double x : {-0.12, 0.12}) {
+    const Eigen::Vector3d tip(x, -0.05 * std::cos(rise), 0.4 + 0.05 * std::sin(rise));
+    parts.push_back(rod({x, 0.005, 0.4}, tip, 0.003));
+    parts.push_back(rod(tip, tip + Eigen::Vector3d(0, 0, 0.02), 0.003));
+  }
+  const Mesh hooks = scenes::merge(parts, "wall_j_hooks");
+  const std::optional<Candidate> best = bestHung(mug, hooks);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
+  EXPECT_GT(best->placement.approach.direction.y(), 0.95) << "not threaded along the arm from its tip";
+  const Eigen::Vector3d com = best->X_WO * mug.properties.center_of_mass;
+  int on_arm = 0;
+  for (const ContactPoint& p : best->contacts)
+    on_arm += p.p_W.z() > com.z() + 0.01 && p.p_W.y() < 0 && p.p_W.y() > -0.05 && p.p_W.z() < 0.415;
+  EXPECT_GT(on_arm, 0) << "it does not hang from a hook's arm";
+  expectStillHangsInBullet(mug, hooks, *best);
+}
+
 // A board 12 cm tall with three 10 mm pegs 8 cm long rising 10 degrees (not in the suite).
 Mesh shortBoardOfRisingPegs() {
   std::vector<Mesh> parts{scenes::box(0.5, 0.02, 0.12, {0, 0.01, 0.4})};

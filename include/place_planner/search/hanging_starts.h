@@ -18,6 +18,9 @@ struct HangingStart {
   Eigen::Vector3d approach;    // G, unit: the threading motion, along the peg towards its base
   double approach_distance = 0;  // m: from wholly beyond the tip to the threaded pose, checked free
   Eigen::Vector3d peg_point;   // G: where on the peg (reported as the candidate's floor point)
+  // Rolled about the peg and turned about the vertical off its rest: its tree swings to rest
+  // before the fall cut may end it (PegLine::swing_first).
+  bool turned = false;
 };
 
 // For each peg (in order) and each loop wide enough for it, both ways round the peg: the loop's
@@ -28,7 +31,8 @@ struct HangingStart {
 // that pose without touching the area (the first free of each peg, loop and way round). Where
 // none is, the same turned a quarter about the peg either way and lifted by up to four times the
 // loop's room (an opening longer than its largest circle passes a tall turned-up tip upright),
-// kept when the object also meets the peg moving up and moving down from it (round it). On a
+// kept when the object also meets the peg moving up and moving down from it (round it); where
+// none of those is, the same also turned 35 degrees either way about the vertical. On a
 // peg rising more than half the friction angle atan(friction) / 2 it is then slid down the peg
 // to its first contact there (the wall, a post), where it would come to rest.
 std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,

@@ -18,6 +18,11 @@ namespace place_planner {
 struct PegLine {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();  // unit; zero: no peg known
+  // The root was turned about the vertical off its hanging rest (a mug's body swung out from
+  // a J-hook's wall): far past its support by construction, it swings to rest before the fall
+  // cut may end it. Only those: a basket rolled onto a towel rail, swung on instead of cut,
+  // stopped 1 cm above the rest Bullet finds (turned 30 degrees about the rail).
+  bool swing_first = false;
   bool known() const { return axis.squaredNorm() > 0; }
 };
 

@@ -20,7 +20,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   std::vector<HangingStart> starts;
   std::vector<TranslationQuery> sweeps;
   std::vector<int> group;          // per start: its peg, loop and way round
-  std::vector<char> phase_of;      // per start: its phase (0 centred, 1 off the axis, 2 rolled)
+  std::vector<char> phase_of;      // per start: its phase (0 centred, 1 off the axis, 2 rolled, 3 rolled and turned)
   int groups = 0;
   const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d com_O = toEigen(om.com);
@@ -46,9 +46,17 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         // handle, 6 cm tall and 3 cm deep) passes over a tip that turns up (a J-hook's, a cup
         // hook's) with that length upright, lifted by up to four times the circle's room; the
         // swing then turns it to its rest about the peg.
-        for (const double roll : {0.0, 0.5 * M_PI, -0.5 * M_PI}) {
-          const Eigen::Matrix3d R = Eigen::AngleAxisd(roll, peg.axis).toRotationMatrix() * R_rest;
-          const char phase = roll == 0.0 ? 0 : 2;
+        // Rolled and also turned about the vertical (phase 3, only where phases 0-2 leave it
+        // unthreaded): a mug's body beside its handle swings away from the wall a short J-hook
+        // stands on, so the handle passes the hook's tip before the body meets the wall.
+        constexpr double kYaw = 35.0 * M_PI / 180.0;
+        const std::pair<double, double> turns[] = {{0.0, 0.0},          {0.5 * M_PI, 0.0},  {-0.5 * M_PI, 0.0},
+                                                   {0.5 * M_PI, kYaw},  {0.5 * M_PI, -kYaw}, {-0.5 * M_PI, kYaw},
+                                                   {-0.5 * M_PI, -kYaw}};
+        for (const auto& [roll, yaw] : turns) {
+          const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                                    Eigen::AngleAxisd(roll, peg.axis).toRotationMatrix() * R_rest;
+          const char phase = roll == 0.0 ? 0 : yaw == 0.0 ? 2 : 3;
           // How far the object reaches from the loop's centre towards the base.
           double back = 0;
           for (const V3& v : om.vertices) back = std::max(back, -(R * (toEigen(v) - loop.centre)).dot(peg.axis));
@@ -95,12 +103,13 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
             h.approach = -peg.axis;
             h.approach_distance = (length - along) + back + 0.01;
             h.peg_point = at;
+            h.turned = phase == 3;
             Eigen::Isometry3d pre = X;
             pre.translation() += h.approach_distance * peg.axis;
             sweeps.push_back(TranslationQuery{toRigid(pre), toV3(h.approach), h.approach_distance + 0.01});
             starts.push_back(h);
             group.push_back(groups);
-            phase_of.push_back(phase == 0 ? (j >= 2 ? 1 : 0) : 2);
+            phase_of.push_back(phase == 0 ? (j >= 2 ? 1 : 0) : phase);
           }
         }
         ++groups;
@@ -113,7 +122,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   std::vector<double> t(starts.size(), -1.0);  // -1: not swept
   auto isFree = [&](size_t i) { return t[i] >= starts[i].approach_distance + 1e-3; };
   std::vector<char> threaded(groups, 0);  // one start per peg, loop and way round: the first free
-  for (const char phase : {0, 1, 2}) {
+  for (const char phase : {0, 1, 2, 3}) {
     std::vector<TranslationQuery> batch;
     std::vector<size_t> which;
     for (size_t i = 0; i < starts.size(); ++i)
@@ -125,7 +134,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
     std::vector<double> tb;
     backend.distance(batch, tb);
     for (size_t j = 0; j < which.size(); ++j) t[which[j]] = tb[j];
-    if (phase == 2) {
+    if (phase >= 2) {
       // A rolled start lifted that far may pass over the whole object, not through its loop:
       // threaded only when the object meets the peg both ways across it, up and down.
       std::vector<TranslationQuery> ud;

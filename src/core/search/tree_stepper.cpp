@@ -27,8 +27,10 @@ const bool kTrace = std::getenv("PP_TRACE") != nullptr;
 constexpr double kSmallTurn = 2.0 * M_PI / 180.0;
 constexpr int kMaxTurnsPerRotation = 4;
 constexpr int kMaxRocks = 8;  // rock settle steps per tree
-constexpr int kMaxSwings = 40;
-constexpr double kSwingDrop = 1e-6;  // m  // swing steps per tree (swingStep: 5 halvings and the moves between)
+// Swing steps per tree: a mug swung in from a start turned about the vertical (hanging_starts)
+// took up to 72 on J-hooks.
+constexpr int kMaxSwings = 120;
+constexpr double kSwingDrop = 1e-6;  // m: a swing move counts when it lowers the centre of mass this much
 // Roll settle: coarse roll steps searched each way, their size, the fine steps refining a
 // bottom within a coarse step either side, and the steepest roll axis.
 constexpr int kRollSteps = 8;
@@ -307,7 +309,8 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
       for (const ContactPoint& c : n.contacts) low = std::min(low, c.p_W.z());
       overhang = surfaceBelow(ctx_.am.grid, com.x(), com.y(), kFallProbe) < low - kFallDrop;
     }
-    const bool falls = overhang && n.overhang;
+    // A root turned off its hanging rest swings to it first (PegLine::swing_first).
+    const bool falls = overhang && n.overhang && (!n.peg.swing_first || n.swung || n.swings >= kMaxSwings);
     n.overhang = overhang;
     // Local optimisation (Section VI): slide down the slope, or tip into the failure direction.
     auto optimise = [&] {

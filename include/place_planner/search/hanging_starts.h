@@ -32,7 +32,7 @@ struct HangingStart {
 // none is, the same turned a quarter about the peg either way and lifted by up to four times the
 // loop's room (an opening longer than its largest circle passes a tall turned-up tip upright),
 // kept when the object also meets the peg moving up and moving down from it (round it); where
-// none of those is, the same also turned 35 degrees either way about the vertical. On a
+// none of those is, the same also turned 20, 35 or 50 degrees either way about the vertical. On a
 // peg rising more than half the friction angle atan(friction) / 2 it is then slid down the peg
 // to its first contact there (the wall, a post), where it would come to rest.
 std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,

@@ -258,12 +258,14 @@ struct SearchMonitor {
     // Penetration guard: an object inside the area by more than a sphere radius below a
     // surface, or by more than 2.5 radii (the contact distance) in a wall or a post, is not
     // stable (the new stable leaves tested on the pool; penetration.h, kSidewaysPenetration).
+    // Hanging leaves by all the object's probes, standing ones by its vertices (penetration.h).
     std::vector<size_t> fresh;
     for (; seen < all.size(); ++seen)
       if (all[seen].stable) fresh.push_back(seen);
     std::vector<char> inside(fresh.size(), 0);
     parallelFor(fresh.size(), config.threads, [&](size_t k) {
-      inside[k] = !penetration(om, am, all[fresh[k]].X_GO).within(penetration_limit, penetration_sideways);
+      const TreeLeaf& l = all[fresh[k]];
+      inside[k] = !penetration(om, am, l.X_GO, 0.03, l.hanging).within(penetration_limit, penetration_sideways);
     });
     for (size_t k = 0; k < fresh.size(); ++k)
       if (inside[k]) all[fresh[k]].stable = false;
@@ -383,6 +385,9 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache) {
                              m.object_small = decimated(run.object, max_tri, &m.object_cell, &run.stop);
                            m.om = buildObjectModel(m.searched(run.object), m.rad.r, &run.stop);
                            m.am = area_model.get();
+                           // Where the area has pegs, a hanging pose's guard probes the object's
+                           // long faces (penetration.h).
+                           if (!m.pegs.empty()) addProbes(m.om, 4.0 * m.rad.r);
                            return true;
                          },
                          run.stop, run.setup_going)

@@ -481,6 +481,24 @@ TEST(Penetration, InsideAVerticalPost) {
   EXPECT_EQ(penetrationDepth(om, am, toRigid(X)), 0.0);
 }
 
+// A post 2.8 cm thick through the side of a 12-triangle box, 1 cm deep: no vertex of either lies
+// inside the other, so the vertices see nothing; the probes on the box's long faces do
+// (ObjectModel::probes), and find it about 1 cm deep.
+TEST(Penetration, AThickPostThroughALongFaceIsSeenByTheProbes) {
+  const Mesh post = scenes::cylinder(0.014, 0.40, 24);
+  const AreaModel am = buildAreaModel(transformed(post, Eigen::Matrix3d::Identity(), {0, 0, 0.2}), {0, 0, -1},
+                                      0.002, 0.0035, 0.0035);
+  ObjectModel om = buildObjectModel(scenes::box(0.10, 0.10, 0.10), 0.002);
+  addProbes(om, 0.008);
+  ASSERT_GT(om.probes.size(), om.vertices.size());
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(0.014 + 0.05 - 0.01, 0, 0.2);  // the box's -x face 1 cm into the post
+  EXPECT_EQ(penetrationDepth(om, am, toRigid(X), 0.03, false), 0.0) << "a vertex is inside";
+  EXPECT_NEAR(penetrationDepth(om, am, toRigid(X)), 0.01, 0.003);
+  X.translation().x() = 0.014 + 0.05 + 0.002;  // clear of it
+  EXPECT_EQ(penetrationDepth(om, am, toRigid(X)), 0.0);
+}
+
 TEST(Ranking, TheLargerTippingMarginRanksFirstAmongEqualPoses) {
   // Two stable poses of a 10 cm cube on a flat top, alike in Q, contacts and robust share; one
   // tips off after 2 degrees of tilt, the other after 8. The tie-break alone (nearer the frame's

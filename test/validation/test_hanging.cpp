@@ -244,8 +244,8 @@ TEST(Hanging, YcbMugIsLiftedOverACupHooksTipAndHangsOnItsArm) {
 }
 
 // A rod of radius r from a to b (a cylinder along z, centred, turned and moved there).
-Mesh rod(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r) {
-  Mesh c = scenes::cylinder(r, (b - a).norm(), 12);
+Mesh rod(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r, int segments = 12) {
+  Mesh c = scenes::cylinder(r, (b - a).norm(), segments);
   const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), b - a).toRotationMatrix();
   for (Eigen::Vector3d& v : c.vertices) v = R * v + 0.5 * (a + b);
   return buildMesh(c.vertices, c.patches, "rod");
@@ -300,6 +300,37 @@ TEST(Hanging, YcbMugTurnsItsBodyOutFromTheWallToPassAShortJHooksTip) {
     on_arm += p.p_W.z() > com.z() + 0.01 && p.p_W.y() < 0 && p.p_W.y() > -0.05 && p.p_W.z() < 0.415;
   EXPECT_GT(on_arm, 0) << "it does not hang from a hook's arm";
   expectStillHangsInBullet(mug, hooks, *best);
+}
+
+// A mug tree (not in the suite): a 2.8 cm trunk, four 8 mm arms 7 cm long rising 20 degrees,
+// two at 25 cm and two at 33 cm. The built-in mug's body is 32-sided: no vertex between its
+// rims, so a swing that pushes its side into the trunk leaves every vertex outside it; the
+// result's guard also probes its long faces (ObjectModel::probes). The best pose keeps the mug
+// out of the trunk (no surface point more than 2 mm inside) and Bullet keeps it hanging.
+// (With the vertices alone it hung 1 cm into the trunk and Bullet threw it up the arm.)
+TEST(Hanging, AMugsLongSideFacesStayOutOfAMugTreesTrunk) {
+  const Mesh mug = scenes::byName("loop_mug");
+  std::vector<Mesh> parts{rod({0, 0, 0}, {0, 0, 0.02}, 0.11, 32), rod({0, 0, 0.01}, {0, 0, 0.42}, 0.014, 24)};
+  for (int k = 0; k < 4; ++k) {
+    const double yaw = k * M_PI / 2 + 0.3, rise = 20 * M_PI / 180;
+    const Eigen::Vector3d d(std::cos(yaw) * std::cos(rise), std::sin(yaw) * std::cos(rise), std::sin(rise));
+    const Eigen::Vector3d root(0, 0, k % 2 ? 0.33 : 0.25);
+    parts.push_back(rod(root + 0.01 * d, root + 0.08 * d, 0.004, 16));
+  }
+  const Mesh tree = scenes::merge(parts, "four_armed_tree");
+  const std::optional<Candidate> best = bestHung(mug, tree);
+  ASSERT_TRUE(best);
+  EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
+  double deepest = 0;  // into the trunk, of points 2 mm apart on the mug's triangles
+  for (const auto& t : mug.triangles)
+    for (int i = 0; i <= 20; ++i)
+      for (int j = 0; i + j <= 20; ++j) {
+        const Eigen::Vector3d p = best->X_WO * ((mug.vertices[t[0]] * (20 - i - j) + mug.vertices[t[1]] * i +
+                                                 mug.vertices[t[2]] * j) / 20.0);
+        if (p.z() > 0.02 && p.z() < 0.42) deepest = std::max(deepest, 0.014 - p.head<2>().norm());
+      }
+  EXPECT_LT(deepest, 0.002) << "the mug is inside the trunk";
+  expectStillHangsInBullet(mug, tree, *best);
 }
 
 // A board 12 cm tall with three 10 mm pegs 8 cm long rising 10 degrees (not in the suite).

@@ -4,16 +4,17 @@
 
 namespace place_planner {
 
-// Deepest object vertex inside the area: a ray from the vertex (against gravity, and along the
-// four horizontal axes of G) that first meets an area triangle from its back (the triangle's
-// normal points along the ray) starts inside that surface, by the hit distance times the
-// normal's part along the ray (the depth along the surface's normal); a vertex's depth is the
-// least over its rays that start inside (inside a vertical post only the sideways rays see it).
+// Deepest object probe (a vertex, or a point on a long triangle: ObjectModel::probes) inside
+// the area: a ray from the probe (against gravity, and along the four horizontal axes of G)
+// that first meets an area triangle from its back (the triangle's normal points along the ray)
+// starts inside that surface, by the hit distance times the normal's part along the ray (the
+// depth along the surface's normal); a probe's depth is the least over its rays that start
+// inside (inside a vertical post only the sideways rays see it).
 // Hits farther than `max_depth` are taken as another surface (an overhang), not penetration.
 // Assumes the area's patch normals point out of its solid parts, as in reconstructed and CAD
 // meshes.
 double penetrationDepth(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
-                        double max_depth = 0.03);
+                        double max_depth = 0.03, bool dense = true);
 
 // The same (depth), and the deepest below a surface straight above (the upward rays alone:
 // the guard's measure before the sideways rays, still held to a sphere radius).
@@ -26,7 +27,12 @@ struct Penetration {
     return below <= below_limit && (sideways_limit <= 0 || depth <= sideways_limit);
   }
 };
+// dense: all the object's probes (ObjectModel::probes), else its vertices only. A standing pose
+// comes from V-C's exact rotations, each stopped at the first contact of the sphere models, so
+// its vertices suffice; a hanging pose's swing lowers each move straight down after a turn,
+// which can push a long face sideways over a thin post or arm: the result's guard checks a
+// hanging pose densely (the probes are 10-70 times the vertices).
 Penetration penetration(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
-                        double max_depth = 0.03);
+                        double max_depth = 0.03, bool dense = true);
 
 }  // namespace place_planner

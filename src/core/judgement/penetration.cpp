@@ -8,8 +8,10 @@
 namespace place_planner {
 
 Penetration penetration(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
-                        double max_depth) {
-  const BvhView obj = view(object.vertex_bvh), tris = view(area.triangle_bvh);
+                        double max_depth, bool dense) {
+  dense = dense && !object.probes.empty();  // none added: the vertices
+  const std::vector<V3>& probes = dense ? object.probes : object.vertices;
+  const BvhView obj = view(dense ? object.probe_bvh : object.vertex_bvh), tris = view(area.triangle_bvh);
   // Rays against gravity and along the four horizontal axes of G: a vertex inside a floor is
   // seen from below it, a vertex inside a wall or a post only sideways (straight up it meets
   // the post's top, far off, or nothing).
@@ -19,15 +21,15 @@ Penetration penetration(const ObjectModel& object, const AreaModel& area, const 
   // (dualTraverse) per ray instead of one ray from the root per vertex: about 3x faster.
   thread_local std::vector<double> nearest, depth;
   thread_local std::vector<int> hit;
-  depth.assign(object.vertices.size(), kInf);
+  depth.assign(probes.size(), kInf);
   double up = 0;  // the deepest below a surface straight above
   for (int k = 0; k < 5; ++k) {
     const V3 dir = dirs[k];
-    nearest.assign(object.vertices.size(), max_depth);
-    hit.assign(object.vertices.size(), -1);
+    nearest.assign(probes.size(), max_depth);
+    hit.assign(probes.size(), -1);
     dualTraverse(
         obj, tris, [&](const BvhNode& n) { return sweepBox(transformBox(X_GO, n.box), dir, max_depth); },
-        [&](int vi) { return apply(X_GO, object.vertices[vi]); },
+        [&](int vi) { return apply(X_GO, probes[vi]); },
         [&](const V3& v, int vi, int t) {
           const auto& tri = area.triangles[t];
           const double d = rayTriangle(v, dir, area.vertices[tri[0]], area.vertices[tri[1]], area.vertices[tri[2]]);
@@ -57,8 +59,8 @@ Penetration penetration(const ObjectModel& object, const AreaModel& area, const 
 }
 
 double penetrationDepth(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
-                        double max_depth) {
-  return penetration(object, area, X_GO, max_depth).depth;
+                        double max_depth, bool dense) {
+  return penetration(object, area, X_GO, max_depth, dense).depth;
 }
 
 }  // namespace place_planner

@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <future>
 #include <atomic>
 #include <cstdint>
@@ -193,6 +194,46 @@ ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius, const S
   o.bounding_radius = object_O.properties.bounding_radius;
   o.principal_axes = object_O.properties.principal_axes;
   return o;
+}
+
+void addProbes(ObjectModel& o, double spacing) {
+  // Coarser where `spacing` would give more than kMaxProbes (a large, coarse object).
+  constexpr size_t kMaxProbes = 20000;
+  o.probe_spacing = spacing;
+  for (;;) {
+    o.probes = o.vertices;
+    const double s = o.probe_spacing;
+    // Splits the triangle at its longest edge's midpoint until that edge is at most s.
+    std::function<void(const V3&, const V3&, const V3&, int)> split = [&](const V3& a, const V3& b, const V3& c,
+                                                                         int depth) {
+      const double lab = norm(b - a), lbc = norm(c - b), lca = norm(a - c);
+      const double l = std::max({lab, lbc, lca});
+      if (l <= s || depth > 24 || o.probes.size() > kMaxProbes) {
+        if (depth > 0) o.probes.push_back((a + b + c) * (1.0 / 3.0));
+        return;
+      }
+      if (l == lab) {
+        const V3 m = (a + b) * 0.5;
+        o.probes.push_back(m);
+        split(a, m, c, depth + 1), split(m, b, c, depth + 1);
+      } else if (l == lbc) {
+        const V3 m = (b + c) * 0.5;
+        o.probes.push_back(m);
+        split(b, m, a, depth + 1), split(m, c, a, depth + 1);
+      } else {
+        const V3 m = (c + a) * 0.5;
+        o.probes.push_back(m);
+        split(c, m, b, depth + 1), split(m, a, b, depth + 1);
+      }
+    };
+    for (const auto& t : o.triangles) split(o.vertices[t[0]], o.vertices[t[1]], o.vertices[t[2]], 0);
+    if (o.probes.size() <= kMaxProbes) break;
+    o.probe_spacing *= 1.5;
+  }
+  std::vector<Aabb> boxes;
+  boxes.reserve(o.probes.size());
+  for (const V3& p : o.probes) boxes.push_back(Aabb{p, p});
+  o.probe_bvh = buildBvh(boxes);
 }
 
 AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,

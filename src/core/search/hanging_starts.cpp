@@ -26,6 +26,18 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   int groups = 0;
   const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d com_O = toEigen(om.com);
+  // Rolled and also turned about the vertical by 20, 35 or 50 degrees either way (phase 3,
+  // only where phases 0-2 leave it unthreaded; the least turn that threads is kept): a
+  // mug's body beside its handle swings away from the wall a short J-hook stands on, so the
+  // handle passes the hook's tip before the body meets the wall. On 36 J-hooks (4-6 cm out,
+  // rising 0-20 degrees, tips 1.5-2.5 cm, 6-8 mm wire) 35 degrees alone hung the YCB mug on
+  // 15 and the tall mug on 19; the three turns 17 and 24 (none before: 0 and 10).
+  // (roll about the peg, yaw about the vertical) of each start off its rest: the rest, rolled a
+  // quarter either way (phase 2, below), and those also turned (phase 3).
+  std::vector<std::pair<double, double>> turns = {{0.0, 0.0}, {0.5 * M_PI, 0.0}, {-0.5 * M_PI, 0.0}};
+  for (const double yaw_deg : {20.0, 35.0, 50.0})
+    for (const double roll : {0.5 * M_PI, -0.5 * M_PI})
+      for (const double sign : {1.0, -1.0}) turns.emplace_back(roll, sign * yaw_deg * M_PI / 180.0);
   for (const Peg& peg : pegs)
     for (const Loop& loop : loops) {
       // The loop must go round the peg (the sweep below checks it with the sphere models).
@@ -48,16 +60,6 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         // handle, 6 cm tall and 3 cm deep) passes over a tip that turns up (a J-hook's, a cup
         // hook's) with that length upright, lifted by up to four times the circle's room; the
         // swing then turns it to its rest about the peg.
-        // Rolled and also turned about the vertical by 20, 35 or 50 degrees either way (phase 3,
-        // only where phases 0-2 leave it unthreaded; the least turn that threads is kept): a
-        // mug's body beside its handle swings away from the wall a short J-hook stands on, so the
-        // handle passes the hook's tip before the body meets the wall. On 36 J-hooks (4-6 cm out,
-        // rising 0-20 degrees, tips 1.5-2.5 cm, 6-8 mm wire) 35 degrees alone hung the YCB mug on
-        // 15 and the tall mug on 19; the three turns 17 and 24 (none before: 0 and 10).
-        std::vector<std::pair<double, double>> turns = {{0.0, 0.0}, {0.5 * M_PI, 0.0}, {-0.5 * M_PI, 0.0}};
-        for (const double yaw_deg : {20.0, 35.0, 50.0})
-          for (const double roll : {0.5 * M_PI, -0.5 * M_PI})
-            for (const double sign : {1.0, -1.0}) turns.emplace_back(roll, sign * yaw_deg * M_PI / 180.0);
         for (const auto& [roll, yaw] : turns) {
           const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
                                     Eigen::AngleAxisd(roll, peg.axis).toRotationMatrix() * R_rest;

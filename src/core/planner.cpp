@@ -51,11 +51,13 @@ constexpr double kSearchShareOfBudget = 0.8;
 struct Radii {
   double r, r_area, cd, cell;
 };
-Radii sphereRadii(const Mesh& object, const PlannerConfig& config) {
+// `r` > 0: the object's sphere radius as given (a hanging object's tight loop, fineRadius).
+Radii sphereRadii(const Mesh& object, const PlannerConfig& config, double r = 0) {
   Radii s;
   const double size = 2.0 * object.properties.bounding_radius;
-  s.r = config.sphere_radius > 0 ? config.sphere_radius
-                                 : std::clamp(0.01 * size, std::max(1e-5, std::min(0.00075, 0.05 * size)), 0.004);
+  s.r = r > 0 ? r
+        : config.sphere_radius > 0 ? config.sphere_radius
+                                   : std::clamp(0.01 * size, std::max(1e-5, std::min(0.00075, 0.05 * size)), 0.004);
   s.r_area = areaSphereRadius(s.r);
   // The grid holds for every object radius of this step (up to r_area / 1.5).
   s.cd = s.r_area + s.r_area / 1.5;
@@ -359,17 +361,19 @@ struct Models {
   // The area's pegs (search/pegs.h), found beside the object's model while it is built; empty
   // unless hanging is asked for.
   std::vector<Peg> pegs;
+  // The object's loops (search/loops.h), found where the area has pegs (fineRadius).
+  std::optional<std::vector<Loop>> loops;
   const Mesh& searched(const Mesh& object) const { return object_small ? *object_small : object; }
 };
 
 // The object's model is built while the area's is built or fetched from the cache; both poll
 // the stop signal. Empty when stopped.
-std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache) {
+std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache, double r = 0) {
   const PlannerConfig& config = run.config;
   Models m;
   m.d_g_W = config.gravity.normalized();
   m.d_vis_W = config.approach.norm() > 1e-9 ? Eigen::Vector3d(config.approach.normalized()) : m.d_g_W;
-  m.rad = sphereRadii(run.object, config);
+  m.rad = sphereRadii(run.object, config, r);
   run.st().sphere_radius = m.rad.r;
   const size_t max_tri = static_cast<size_t>(config.max_triangles);
   checkLimits(run.object, run.area, m.rad, config, run.result);
@@ -392,7 +396,7 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache) {
                          },
                          run.stop, run.setup_going)
                          .has_value();
-  run.st().steps.setup = msSince(tp);
+  run.st().steps.setup += msSince(tp);
   if (!built) return std::nullopt;
   if (m.object_small)
     run.result.warnings.push_back(decimationWarning("object mesh", run.object.triangles.size(),
@@ -406,6 +410,46 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache) {
   m.backend = chooseBackend(m.om, am, TiltParams{0.002, 1e-6 + 1e-4 * m.rad.r}, config, &run.st().backend_note);
   run.st().backend = m.backend->name();
   return m;
+}
+
+// Where the area has pegs and hanging is searched (buildModels found them): the object's loops
+// (kept in `m` for findRoots). False when stopped.
+bool findObjectLoops(PlanRun& run, Models& m) {
+  if (m.pegs.empty()) return true;
+  return runStoppable(
+             [&] {
+               m.loops = findLoops(m.searched(run.object), {}, &run.stop);
+               return true;
+             },
+             run.stop, run.setup_going)
+      .has_value();
+}
+
+// Where the models close even the widest loop-on-peg fit (the contact distance at least the
+// loop's room round the peg: its largest circle less the peg's half width; a loop centred on
+// the peg touches it on both sides), the sphere radius whose contact distance is at most half
+// that room: a pan handle's slot 2 cm wide on a J-hook's 8 mm wire, 6 mm either side, at 9.4 mm.
+// 0: the models built serve (a given sphere_radius is kept; a finer model than needed changed
+// the mugs' answers, measured on the held-out racks). At least the smallest default radius.
+double fineRadius(const PlanRun& run, const Models& m) {
+  if (!m.loops || run.config.sphere_radius > 0) return 0;
+  double room = 0;
+  for (const Peg& peg : m.pegs)
+    for (const Loop& loop : *m.loops)
+      if (loop.radius >= peg.half_width + 0.001) room = std::max(room, loop.radius - peg.half_width);
+  if (room <= 0 || m.rad.cd < room) return 0;
+  // cd = r_area (1 + 1 / 1.5), r_area a step of sqrt(2) from 1 mm and at least 1.5 r
+  // (sphereRadii, areaSphereRadius): the largest such r_area under the bound, r a third smaller.
+  const double r_area = 0.001 * std::pow(std::sqrt(2.0), std::floor(std::log(0.6 * 0.5 * room / 0.001) / std::log(std::sqrt(2.0))));
+  const double r = std::max(r_area / 1.5, 0.00075);
+  if (r >= m.rad.r) return 0;
+  // Within the model memory limit (checkLimits), else as built.
+  const Radii fine = sphereRadii(run.object, run.config, r);
+  const size_t max_tri = static_cast<size_t>(run.config.max_triangles);
+  const double mb = (estimateModelBytes(run.object, fine.r, 0, 0, max_tri) +
+                     estimateModelBytes(run.area, fine.r_area, fine.cd, fine.cell, max_tri)) /
+                    (1024.0 * 1024.0);
+  return mb <= run.config.max_model_mb ? r : 0;
 }
 
 // The roots (IV): floor points (IV-B) by ray casting and start orientations (IV-A); with a
@@ -425,7 +469,7 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
   std::vector<std::string> floor_warnings;
   std::vector<StartOrientation> all;
   const std::vector<Peg>& pegs = m.pegs;
-  std::vector<Loop> loops;
+  std::vector<Loop> loops = m.loops.value_or(std::vector<Loop>{});
   const PlacementKind kind = run.config.placement;
   const bool found = runStoppable(
                          [&] {
@@ -435,7 +479,7 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
                                                      run.config, &run.stop);
                            // Hanging (beyond the paper): the object's loops, when the area has a
                            // peg to hang them on (buildModels).
-                           if (!pegs.empty()) loops = findLoops(m.searched(run.object), {}, &run.stop);
+                           if (!pegs.empty() && !m.loops) loops = findLoops(m.searched(run.object), {}, &run.stop);
                            return true;
                          },
                          run.stop, run.setup_going)
@@ -609,8 +653,19 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   PlanRun run(completion, area, config, progress);
   run.result.stats.spikes_flattened = spikes;
   // ---- models (III, V-B)
-  const std::optional<Models> models = buildModels(run, *cache_);
+  const size_t warnings = run.result.warnings.size();
+  std::optional<Models> models = buildModels(run, *cache_);
   if (!models) return stopped(run.result, run.t0);
+  // A loop whose room round the pegs is under a contact distance (a pan handle's slot on a
+  // J-hook's wire) touches the peg on both sides in the sphere models: rebuilt finer for it.
+  if (!findObjectLoops(run, *models)) return stopped(run.result, run.t0);
+  if (const double r = fineRadius(run, *models); r > 0) {
+    std::optional<std::vector<Loop>> loops = std::move(models->loops);
+    run.result.warnings.resize(warnings);  // said again by the second build
+    models = buildModels(run, *cache_, r);
+    if (!models) return stopped(run.result, run.t0);
+    models->loops = std::move(loops);
+  }
   // ---- floor points (IV-B) and start orientations (IV-A): the roots
   const std::optional<Roots> roots = findRoots(run, *models);
   if (!roots) return stopped(run.result, run.t0);

@@ -21,6 +21,7 @@ struct HangingStart {
   // Rolled about the peg and turned about the vertical off its rest: its tree swings to rest
   // before the fall cut may end it (PegLine::swing_first).
   bool turned = false;
+  double room = 0;  // m: the loop's largest circle less the peg's half width
 };
 
 // For each peg (in order) and each loop wide enough for it, both ways round the peg: the loop's

@@ -23,6 +23,9 @@ struct PegLine {
   // cut may end it. Only those: a basket rolled onto a towel rail, swung on instead of cut,
   // stopped 1 cm above the rest Bullet finds (turned 30 degrees about the rail).
   bool swing_first = false;
+  // m: the loop's room round the peg (its largest circle less the peg's half width); 0: unknown.
+  // A swing's turn may carry the loop across the peg no farther (swingStep's pivot).
+  double room = 0;
   bool known() const { return axis.squaredNorm() > 0; }
 };
 

@@ -22,18 +22,19 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   std::vector<HangingStart> starts;
   std::vector<TranslationQuery> sweeps;
   std::vector<int> group;          // per start: its peg, loop and way round
-  std::vector<char> phase_of;      // per start: its phase (0 centred, 1 off the axis, 2 rolled, 3 rolled and turned)
+  // per start: its phase (0 centred, 1 off the axis, 2 lifted at its rest, 3 rolled, 4 rolled and turned)
+  std::vector<char> phase_of;
   int groups = 0;
   const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d com_O = toEigen(om.com);
-  // Rolled and also turned about the vertical by 20, 35 or 50 degrees either way (phase 3,
-  // only where phases 0-2 leave it unthreaded; the least turn that threads is kept): a
+  // Rolled and also turned about the vertical by 20, 35 or 50 degrees either way (phase 4,
+  // only where phases 0-3 leave it unthreaded; the least turn that threads is kept): a
   // mug's body beside its handle swings away from the wall a short J-hook stands on, so the
   // handle passes the hook's tip before the body meets the wall. On 36 J-hooks (4-6 cm out,
   // rising 0-20 degrees, tips 1.5-2.5 cm, 6-8 mm wire) 35 degrees alone hung the YCB mug on
   // 15 and the tall mug on 19; the three turns 17 and 24 (none before: 0 and 10).
   // (roll about the peg, yaw about the vertical) of each start off its rest: the rest, rolled a
-  // quarter either way (phase 2, below), and those also turned (phase 3).
+  // quarter either way (phase 3, below), and those also turned (phase 4).
   std::vector<std::pair<double, double>> turns = {{0.0, 0.0}, {0.5 * M_PI, 0.0}, {-0.5 * M_PI, 0.0}};
   for (const double yaw_deg : {20.0, 35.0, 50.0})
     for (const double roll : {0.5 * M_PI, -0.5 * M_PI})
@@ -55,7 +56,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         const Eigen::Matrix3d R_rest = to * from.transpose();
         // The loop's room round the peg, by its largest circle.
         const double room = loop.radius - peg.half_width;
-        // Rolled a quarter turn either way about the peg (phase 2, only where the rest's own
+        // Rolled a quarter turn either way about the peg (phase 3, only where the rest's own
         // starts are all blocked): an opening longer one way than its largest circle (a mug's
         // handle, 6 cm tall and 3 cm deep) passes over a tip that turns up (a J-hook's, a cup
         // hook's) with that length upright, lifted by up to four times the circle's room; the
@@ -63,7 +64,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
         for (const auto& [roll, yaw] : turns) {
           const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
                                     Eigen::AngleAxisd(roll, peg.axis).toRotationMatrix() * R_rest;
-          const char phase = roll == 0.0 ? 0 : yaw == 0.0 ? 2 : 3;
+          const char phase = roll == 0.0 ? 0 : yaw == 0.0 ? 3 : 4;
           // How far the object reaches from the loop's centre towards the base.
           double back = 0;
           for (const V3& v : om.vertices) back = std::max(back, -(R * (toEigen(v) - loop.centre)).dot(peg.axis));
@@ -89,11 +90,17 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
           const double off = room / 3.0, lift = std::max(off, room - cd - 0.001);
           const Eigen::Vector3d side = peg.axis.cross(hang);
           std::vector<Eigen::Vector3d> offsets;
+          std::vector<char> phases;
           if (phase == 0) {
             offsets = {Eigen::Vector3d::Zero(), off * hang, -off * hang, off * side, -off * side, -lift * hang};
-            if (lift <= off) offsets.pop_back();  // a loop too tight to lift: as off-centre up
+            phases = {0, 1, 1, 1, 1, 1};
+            if (lift <= off) offsets.pop_back(), phases.pop_back();  // a loop too tight to lift: as off-centre up
+            // At its rest lifted by two to four times the room (phase 2): an opening longer
+            // along the hang than its largest circle (a pan handle's slot) passes over a tip
+            // that turns up as it hangs.
+            for (int k = 2; k <= 4; ++k) offsets.push_back(-(k * room - cd - 0.001) * hang), phases.push_back(2);
           } else {
-            for (int k = 1; k <= 4; ++k) offsets.push_back(-(k * room - cd - 0.001) * hang);
+            for (int k = 1; k <= 4; ++k) offsets.push_back(-(k * room - cd - 0.001) * hang), phases.push_back(phase);
           }
           for (size_t j = 0; j < 2 * offsets.size(); ++j) {
             const bool far_end = j % 2;
@@ -110,13 +117,14 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
             h.approach = -peg.axis;
             h.approach_distance = (length - along) + back + 0.01;
             h.peg_point = at;
-            h.turned = phase == 3;
+            h.turned = phase == 4;
+            h.room = room;
             Eigen::Isometry3d pre = X;
             pre.translation() += h.approach_distance * peg.axis;
             sweeps.push_back(TranslationQuery{toRigid(pre), toV3(h.approach), h.approach_distance + 0.01});
             starts.push_back(h);
             group.push_back(groups);
-            phase_of.push_back(phase == 0 ? (j >= 2 ? 1 : 0) : phase);
+            phase_of.push_back(j < 2 ? phase : phases[j / 2]);
           }
         }
         ++groups;
@@ -129,7 +137,7 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
   std::vector<double> t(starts.size(), -1.0);  // -1: not swept
   auto isFree = [&](size_t i) { return t[i] >= starts[i].approach_distance + 1e-3; };
   std::vector<char> threaded(groups, 0);  // one start per peg, loop and way round: the first free
-  for (const char phase : {0, 1, 2, 3}) {
+  for (const char phase : {0, 1, 2, 3, 4}) {
     std::vector<TranslationQuery> batch;
     std::vector<size_t> which;
     for (size_t i = 0; i < starts.size(); ++i)

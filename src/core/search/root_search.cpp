@@ -86,7 +86,7 @@ void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O,
     while (static_cast<int>(stepper.active()) < target && next < roots.size()) {
       const HangingStart* h = roots.hanging(next);
       stepper.addRoot(roots.pose(next), next, com_O, roots.direction(next), roots.tmax(next),
-                      h ? PegLine{h->peg_point, -h->approach, h->turned} : PegLine{});
+                      h ? PegLine{h->peg_point, -h->approach, h->turned, h->room} : PegLine{});
       ++next;
     }
     if (stepper.empty()) break;

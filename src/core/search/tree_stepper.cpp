@@ -399,41 +399,83 @@ void TreeStepper::swingStep() {
   // above can do).
   constexpr int kMoves = 1 + 2 * 2 + 2 + 2 + 1;
   const double gap = 0.5 * ctx_.cd;
-  std::vector<TranslationQuery> q;
+  // Per node: the pivot, how far its contacts spread about it, the centre of mass's depth
+  // below it, and the horizontal axes along and across the peg (swingStep runs on known pegs).
+  struct Frame {
+    Eigen::Vector3d mid, com, along, across;
+    double reach, depth;
+  };
+  std::vector<Frame> frames;
+  std::vector<TranslationQuery> q, across_q;
   q.reserve(swinging_.size() * kMoves);
   for (TreeNode& n : swinging_) {
     if (n.swing_step <= 0) n.swing_step = kSwingStart;
-    Eigen::Vector3d mid = Eigen::Vector3d::Zero();
-    for (const ContactPoint& c : n.contacts) mid += c.p_W;
-    mid /= static_cast<double>(std::max<size_t>(1, n.contacts.size()));
-    double reach = ctx_.cd;  // how far the contacts spread about the middle: what may dig in
-    for (const ContactPoint& c : n.contacts) reach = std::max(reach, (c.p_W - mid).norm() + ctx_.cd);
-    const Eigen::Vector3d com = toEigen(apply(n.X_GO, n.com_O));
-    const double depth = std::max(mid.z() - com.z(), ctx_.cd);
+    // The pivot: the middle of its contacts (held by the peg and leaning on a board, it turns
+    // about both), or of the loop's contacts on the peg (those nearest its axis) where the
+    // swing's first turn about the former would carry the loop across the peg farther than its
+    // room (PegLine::room; a pan's disc leaning on the wall 10 cm below a slot with 6 mm either
+    // side of the wire): lowered straight down, nothing stops the loop's side going into the
+    // peg, and only the result's guard would see it (the vertices are far off). Mugs leaning on
+    // a rack's board or a tree's trunk keep the middle of all (turns of 1-4 mm at their loops).
+    auto toAxis = [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d v = p - n.peg.point;
+      return (v - v.dot(n.peg.axis) * n.peg.axis).norm();
+    };
+    double nearest = kInf;
+    for (const ContactPoint& c : n.contacts) nearest = std::min(nearest, toAxis(c.p_W));
+    Frame f;
+    Eigen::Vector3d on_peg = Eigen::Vector3d::Zero();
+    f.mid = Eigen::Vector3d::Zero();
+    int m = 0;
+    for (const ContactPoint& c : n.contacts) {
+      f.mid += c.p_W / static_cast<double>(n.contacts.size());
+      if (toAxis(c.p_W) <= nearest + 1.5 * ctx_.cd) on_peg += c.p_W, ++m;
+    }
+    on_peg /= static_cast<double>(std::max(1, m));
+    if (n.peg.room > 0 && (on_peg - f.mid).norm() * kSwingStart > n.peg.room) f.mid = on_peg;
+    f.reach = ctx_.cd;  // how far the contacts spread about the middle: what may dig in
+    for (const ContactPoint& c : n.contacts) f.reach = std::max(f.reach, (c.p_W - f.mid).norm() + ctx_.cd);
+    f.com = toEigen(apply(n.X_GO, n.com_O));
+    f.depth = std::max(f.mid.z() - f.com.z(), ctx_.cd);
+    f.along = Eigen::Vector3d(n.peg.axis.x(), n.peg.axis.y(), 0).normalized();
+    f.across = Eigen::Vector3d::UnitZ().cross(f.along);
+    // The slides across the peg, swept first (lifted off the peg's top): one ends where the
+    // loop's side meets the peg (a pan handle's slot, 6 mm either side of a J-hook's wire), as
+    // V-A's translation does.
+    Rigid Y = n.X_GO;
+    Y.t = Y.t + v3(0, 0, gap);
+    for (const double sign : {1.0, -1.0})
+      across_q.push_back(TranslationQuery{Y, toV3(sign * f.across), n.swing_step * f.depth});
+    frames.push_back(f);
+  }
+  std::vector<double> d, d_across;
+  ctx_.backend.distance(across_q, d_across);
+  for (size_t i = 0; i < swinging_.size(); ++i) {
+    const TreeNode& n = swinging_[i];
+    const Frame& f = frames[i];
     const double t = n.swing_step;
-    // Horizontal axes along and across the peg (swingStep runs on known pegs only).
-    const Eigen::Vector3d along = Eigen::Vector3d(n.peg.axis.x(), n.peg.axis.y(), 0).normalized();
-    const Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(along);
     auto push = [&](const Rigid& Y0, double lift) {
       Rigid Y = Y0;
       Y.t = Y.t + v3(0, 0, lift);
       q.push_back(TranslationQuery{Y, v3(0, 0, -1), lift + gap + 0.01});
     };
     push(n.X_GO, gap);
-    for (const Eigen::Vector3d& axis : {along, across})
-      for (const double sign : {1.0, -1.0}) push(rotatedAbout(n.X_GO, mid, axis, sign * t), gap + reach * t);
+    for (const Eigen::Vector3d& axis : {f.along, f.across})
+      for (const double sign : {1.0, -1.0}) push(rotatedAbout(n.X_GO, f.mid, axis, sign * t), gap + f.reach * t);
     // Round the peg's axis: the loop slides round the peg (its contact moves over the peg).
-    for (const double sign : {1.0, -1.0}) push(rotatedAbout(n.X_GO, n.peg.point, n.peg.axis, sign * t), gap + reach * t);
-    for (const double sign : {1.0, -1.0}) push(translated(n.X_GO, toV3(sign * t * depth * across)), gap);
+    for (const double sign : {1.0, -1.0}) push(rotatedAbout(n.X_GO, n.peg.point, n.peg.axis, sign * t), gap + f.reach * t);
+    for (int k = 0; k < 2; ++k) {
+      const double len = std::min(t * f.depth, d_across[2 * i + k]);
+      push(translated(n.X_GO, toV3((k == 0 ? 1.0 : -1.0) * len * f.across)), gap);
+    }
     {
       // A point at the contacts' reach moves t * depth (a slide's length).
-      const double len = t * depth;
+      const double len = t * f.depth;
       const Eigen::Vector3d w = len * n.settle_w;
-      Rigid Y = w.norm() > 0 ? rotatedAbout(n.X_GO, com, w.normalized(), w.norm()) : n.X_GO;
+      Rigid Y = w.norm() > 0 ? rotatedAbout(n.X_GO, f.com, w.normalized(), w.norm()) : n.X_GO;
       push(translated(Y, toV3(len * n.settle_v)), gap + len);
     }
   }
-  std::vector<double> d;
   ctx_.backend.distance(q, d);
   for (size_t i = 0; i < swinging_.size(); ++i) {
     TreeNode& n = swinging_[i];

@@ -27,15 +27,16 @@ struct HangingStart {
 // For each peg (in order) and each loop wide enough for it, both ways round the peg: the loop's
 // axis along the peg, turned about it so that the centre of mass hangs below the loop, and far
 // enough along the peg that the object clears the peg's base (or, where it reaches back past
-// the room, at the far end only), centred on the peg, off it a little or lifted over a tip that
+// the room, that the loop does), centred on the peg, off it a little or lifted over a tip that
 // turns up. Kept when the object's sphere model sweeps along the peg from beyond its tip to
 // that pose without touching the area (the first free of each peg, loop and way round). Where
-// none is, the same turned a quarter about the peg either way and lifted by up to four times the
+// none is, the same lifted by two to four times the loop's room (a slot long along the hang),
+// then the same turned a quarter about the peg either way and lifted by up to four times the
 // loop's room (an opening longer than its largest circle passes a tall turned-up tip upright),
-// kept when the object also meets the peg moving up and moving down from it (round it); where
-// none of those is, the same also turned 20, 35 or 50 degrees either way about the vertical. On a
-// peg rising more than half the friction angle atan(friction) / 2 it is then slid down the peg
-// to its first contact there (the wall, a post), where it would come to rest.
+// these kept when the object also meets the peg moving up and moving down from it (round it);
+// where none of those is, the same also turned 20, 35 or 50 degrees either way about the
+// vertical. On a peg rising more than half the friction angle atan(friction) / 2 it is then slid
+// down the peg to its first contact there (the wall, a post), where it would come to rest.
 std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std::vector<Loop>& loops,
                                         const ObjectModel& om, Backend& backend, double collision_distance,
                                         double friction);

@@ -74,10 +74,13 @@ std::vector<HangingStart> hangingStarts(const std::vector<Peg>& pegs, const std:
           // meets neither.
           const double length = peg.to_base + peg.to_tip;
           // Where the object reaches farther back than the peg is long (a mug's body below a cup
-          // hook's short arm), only the far end is tried: the sweep finds whether what hangs below
-          // the peg clears its base (a wall does not let it; a hook's stem above the arm does).
+          // hook's short arm), the room starts at the loop's own clearance of the base: the sweep
+          // finds whether what hangs below the peg clears the base (a wall does not let it; a
+          // hook's stem above the arm does). (Only the far end was tried there: a pan's slot,
+          // threaded against a cup hook's turned-up tip, fell off it in Bullet.)
           const double farthest = length - 0.5 * loop.thickness - std::min(0.5 * loop.thickness, 0.01);
-          const double nearest = std::min(back + cd + 0.001, farthest);
+          const double nearest = back + cd + 0.001 < farthest ? back + cd + 0.001
+                                                                : std::min(0.5 * loop.thickness + cd + 0.001, farthest);
           if (farthest <= 0) continue;
           // Threaded to the middle of that room or, where the sweep finds the middle blocked (a
           // wide loop on a steep arm meets the post behind it), to its far end: on a rising peg it

@@ -251,6 +251,19 @@ Mesh rod(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r, int segme
   return buildMesh(c.vertices, c.patches, "rod");
 }
 
+// Two J-hooks on a wall (y in [0, 0.02]), 24 cm apart, 40 cm up: an arm 5 cm out rising 10
+// degrees and a tip turned up 2 cm, rods of wire radius `r`.
+Mesh wallJHooks(double r) {
+  const double rise = 10 * M_PI / 180;
+  std::vector<Mesh> parts{scenes::box(0.6, 0.02, 0.6, {0, 0.01, 0.3})};
+  for (const double x : {-0.12, 0.12}) {
+    const Eigen::Vector3d tip(x, -0.05 * std::cos(rise), 0.4 + 0.05 * std::sin(rise));
+    parts.push_back(rod({x, 0.005, 0.4}, tip, r));
+    parts.push_back(rod(tip, tip + Eigen::Vector3d(0, 0, 0.02), r));
+  }
+  return scenes::merge(parts, "wall_j_hooks");
+}
+
 // Cup hooks whose tip turns up 2.5 cm (not in the suite; the suite's turn up 1 cm): a stem 7 cm
 // down from a shelf board, an arm 4 cm out, 6 mm wire. The tip with the arm under it stands 3.1
 // cm; the YCB mug's handle, turned as it hangs, leaves 2.4 cm over the arm (its largest circle):
@@ -282,14 +295,7 @@ TEST(Hanging, YcbMugTurnsItsHandleUprightToPassOverATallHookTip) {
 TEST(Hanging, YcbMugTurnsItsBodyOutFromTheWallToPassAShortJHooksTip) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
-  const double rise = 10 * M_PI / 180;
-  std::vector<Mesh> parts{scenes::box(0.6, 0.02, 0.6, {0, 0.01, 0.3})};
-  for (const double x : {-0.12, 0.12}) {
-    const Eigen::Vector3d tip(x, -0.05 * std::cos(rise), 0.4 + 0.05 * std::sin(rise));
-    parts.push_back(rod({x, 0.005, 0.4}, tip, 0.003));
-    parts.push_back(rod(tip, tip + Eigen::Vector3d(0, 0, 0.02), 0.003));
-  }
-  const Mesh hooks = scenes::merge(parts, "wall_j_hooks");
+  const Mesh hooks = wallJHooks(0.003);
   const std::optional<Candidate> best = bestHung(mug, hooks);
   ASSERT_TRUE(best);
   EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
@@ -313,14 +319,7 @@ TEST(Hanging, APanHangsByTheSlotInItsHandleOnAJHook) {
   for (const double y : {-0.015, 0.015}) pan_parts.push_back(scenes::box(0.06, 0.01, 0.012, {0.23, y, 0.031}));
   for (const double x : {0.2025, 0.255}) pan_parts.push_back(scenes::box(x < 0.25 ? 0.015 : 0.01, 0.04, 0.012, {x, 0, 0.031}));
   const Mesh pan = scenes::merge(pan_parts, "pan");
-  const double rise = 10 * M_PI / 180;
-  std::vector<Mesh> parts{scenes::box(0.6, 0.02, 0.6, {0, 0.01, 0.3})};
-  for (const double x : {-0.12, 0.12}) {
-    const Eigen::Vector3d tip(x, -0.05 * std::cos(rise), 0.4 + 0.05 * std::sin(rise));
-    parts.push_back(rod({x, 0.005, 0.4}, tip, 0.004));
-    parts.push_back(rod(tip, tip + Eigen::Vector3d(0, 0, 0.02), 0.004));
-  }
-  const Mesh hooks = scenes::merge(parts, "wall_j_hooks_8mm");
+  const Mesh hooks = wallJHooks(0.004);
   PlannerConfig c = twoThreads();
   c.placement = PlacementKind::kHanging;
   const PlanResult r = Planner().plan(pan, hooks, c);
@@ -348,7 +347,7 @@ TEST(Hanging, APanHangsByTheSlotInItsHandleOnAJHook) {
   EXPECT_GT(on_wall, 0) << "it does not lean on the wall";
   // (Bullet keeps the pan on J-hooks bent from one wire, scripts/hanging_meshes.py: 3 of 3 best
   // out 5 cm rising 10 degrees; from these, an arm and a tip of two rods, it drops it 5-7 cm:
-  // doc/validation.md, "Hanging: the pan".)
+  // doc/validation.md, "Held-out hanging scenes".)
 }
 
 // A mug tree (not in the suite): a 2.8 cm trunk, four 8 mm arms 7 cm long rising 20 degrees,

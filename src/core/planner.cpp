@@ -361,8 +361,8 @@ struct Models {
   // The area's pegs (search/pegs.h), found beside the object's model while it is built; empty
   // unless hanging is asked for.
   std::vector<Peg> pegs;
-  // The object's loops (search/loops.h), found where the area has pegs (fineRadius).
-  std::optional<std::vector<Loop>> loops;
+  // The object's loops (search/loops.h), found where the area has pegs (findObjectLoops).
+  std::vector<Loop> loops;
   const Mesh& searched(const Mesh& object) const { return object_small ? *object_small : object; }
 };
 
@@ -412,17 +412,20 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache, double r 
   return m;
 }
 
-// Where the area has pegs and hanging is searched (buildModels found them): the object's loops
-// (kept in `m` for findRoots). False when stopped.
+// Where the area has pegs and hanging is searched (buildModels found them): the object's loops,
+// for fineRadius and findRoots (counted in the setup step). False when stopped.
 bool findObjectLoops(PlanRun& run, Models& m) {
   if (m.pegs.empty()) return true;
-  return runStoppable(
-             [&] {
-               m.loops = findLoops(m.searched(run.object), {}, &run.stop);
-               return true;
-             },
-             run.stop, run.setup_going)
-      .has_value();
+  const auto tp = Clock::now();
+  const bool found = runStoppable(
+                         [&] {
+                           m.loops = findLoops(m.searched(run.object), {}, &run.stop);
+                           return true;
+                         },
+                         run.stop, run.setup_going)
+                         .has_value();
+  run.st().steps.setup += msSince(tp);
+  return found;
 }
 
 // Where the models close even the widest loop-on-peg fit (the contact distance at least the
@@ -432,10 +435,10 @@ bool findObjectLoops(PlanRun& run, Models& m) {
 // 0: the models built serve (a given sphere_radius is kept; a finer model than needed changed
 // the mugs' answers, measured on the held-out racks). At least the smallest default radius.
 double fineRadius(const PlanRun& run, const Models& m) {
-  if (!m.loops || run.config.sphere_radius > 0) return 0;
+  if (run.config.sphere_radius > 0) return 0;
   double room = 0;
   for (const Peg& peg : m.pegs)
-    for (const Loop& loop : *m.loops)
+    for (const Loop& loop : m.loops)
       if (loop.radius >= peg.half_width + 0.001) room = std::max(room, loop.radius - peg.half_width);
   if (room <= 0 || m.rad.cd < room) return 0;
   // cd = r_area (1 + 1 / 1.5), r_area a step of sqrt(2) from 1 mm and at least 1.5 r
@@ -469,7 +472,7 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
   std::vector<std::string> floor_warnings;
   std::vector<StartOrientation> all;
   const std::vector<Peg>& pegs = m.pegs;
-  std::vector<Loop> loops = m.loops.value_or(std::vector<Loop>{});
+  const std::vector<Loop>& loops = m.loops;
   const PlacementKind kind = run.config.placement;
   const bool found = runStoppable(
                          [&] {
@@ -477,9 +480,6 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
                            if (kind != PlacementKind::kHanging)
                              all = startOrientations(m.searched(run.object), r.R_held_G, toEigen(m.d_vis), am,
                                                      run.config, &run.stop);
-                           // Hanging (beyond the paper): the object's loops, when the area has a
-                           // peg to hang them on (buildModels).
-                           if (!pegs.empty() && !m.loops) loops = findLoops(m.searched(run.object), {}, &run.stop);
                            return true;
                          },
                          run.stop, run.setup_going)
@@ -660,7 +660,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // J-hook's wire) touches the peg on both sides in the sphere models: rebuilt finer for it.
   if (!findObjectLoops(run, *models)) return stopped(run.result, run.t0);
   if (const double r = fineRadius(run, *models); r > 0) {
-    std::optional<std::vector<Loop>> loops = std::move(models->loops);
+    std::vector<Loop> loops = std::move(models->loops);
     run.result.warnings.resize(warnings);  // said again by the second build
     models = buildModels(run, *cache_, r);
     if (!models) return stopped(run.result, run.t0);

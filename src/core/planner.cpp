@@ -192,6 +192,13 @@ auto runStoppable(F&& step, StopSignal& stop, const std::function<bool()>& keep_
 // Bounded work (work_limits.h): sizes that say "millimetres", model memory; before any model.
 // Both models are estimated, the area's even when cached (one that is over the limit was never
 // built): O(triangles), no hash of the area on top of the cache's own.
+// The sphere models' estimated memory (MB) at these radii.
+double modelMegabytes(const Mesh& object, const Mesh& area, const Radii& rad, const PlannerConfig& config) {
+  const size_t max_tri = static_cast<size_t>(config.max_triangles);
+  return (estimateModelBytes(object, rad.r, 0, 0, max_tri) + estimateModelBytes(area, rad.r_area, rad.cd, rad.cell, max_tri)) /
+         (1024.0 * 1024.0);
+}
+
 void checkLimits(const Mesh& object, const Mesh& area, const Radii& rad, const PlannerConfig& config,
                  PlanResult& result) {
   for (std::string& w : checkMeshSizes(object, area, config)) result.warnings.push_back(std::move(w));
@@ -200,10 +207,7 @@ void checkLimits(const Mesh& object, const Mesh& area, const Radii& rad, const P
       result.warnings.push_back(std::string(m == &object ? "object" : "placement area") + " mesh: " +
                                 std::to_string(m->report.fanned_polygons) +
                                 " self-intersecting polygons triangulated as fans (their shape is approximate)");
-  const size_t max_tri = static_cast<size_t>(config.max_triangles);
-  const double mb = (estimateModelBytes(object, rad.r, 0, 0, max_tri) +
-                     estimateModelBytes(area, rad.r_area, rad.cd, rad.cell, max_tri)) /
-                    (1024.0 * 1024.0);
+  const double mb = modelMegabytes(object, area, rad, config);
   if (mb > config.max_model_mb) {
     char msg[400];
     std::snprintf(msg, sizeof msg,
@@ -447,11 +451,7 @@ double fineRadius(const PlanRun& run, const Models& m) {
   const double r = std::max(r_area / 1.5, 0.00075);
   if (r >= m.rad.r) return 0;
   // Within the model memory limit (checkLimits), else as built.
-  const Radii fine = sphereRadii(run.object, run.config, r);
-  const size_t max_tri = static_cast<size_t>(run.config.max_triangles);
-  const double mb = (estimateModelBytes(run.object, fine.r, 0, 0, max_tri) +
-                     estimateModelBytes(run.area, fine.r_area, fine.cd, fine.cell, max_tri)) /
-                    (1024.0 * 1024.0);
+  const double mb = modelMegabytes(run.object, run.area, sphereRadii(run.object, run.config, r), run.config);
   return mb <= run.config.max_model_mb ? r : 0;
 }
 

@@ -371,7 +371,7 @@ struct Models {
 };
 
 // The object's model is built while the area's is built or fetched from the cache; both poll
-// the stop signal. Empty when stopped.
+// the stop signal. Empty when stopped. `r` > 0: built again finer (fineRadius), the pegs kept.
 std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache, double r = 0) {
   const PlannerConfig& config = run.config;
   Models m;
@@ -386,7 +386,7 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache, double r 
                          [&] {
                            auto area_model = std::async(std::launch::async, [&] {
                              auto am = cache.get(run.area, m.d_g_W, m.rad.r_area, m.rad.cd, m.rad.cell, max_tri, &run.stop);
-                             if (config.placement != PlacementKind::kStanding) m.pegs = findPegs(*am, {}, &run.stop);
+                             if (config.placement != PlacementKind::kStanding && r == 0) m.pegs = findPegs(*am, {}, &run.stop);
                              return am;
                            });
                            if (run.object.triangles.size() > max_tri)
@@ -436,18 +436,30 @@ bool findObjectLoops(PlanRun& run, Models& m) {
 // loop's room round the peg: its largest circle less the peg's half width; a loop centred on
 // the peg touches it on both sides), the sphere radius whose contact distance is at most half
 // that room: a pan handle's slot 2 cm wide on a J-hook's 8 mm wire, 6 mm either side, at 9.4 mm.
+// Where a loop's bar and a peg are both thinner than the contact distance (half its thickness
+// and the peg's half width under it), the contact distance at most the thinner of the two: the
+// contact normals there blend across both round surfaces (a basket's 8 mm arched handle on a
+// cup hook's 6 mm wire at 6.7 mm spread 45 degrees along the wire) and their forces did not
+// balance below a centre of mass hanging straight under the wire.
 // 0: the models built serve (a given sphere_radius is kept; a finer model than needed changed
 // the mugs' answers, measured on the held-out racks). At least the smallest default radius.
 double fineRadius(const PlanRun& run, const Models& m) {
   if (run.config.sphere_radius > 0) return 0;
-  double room = 0;
+  double room = 0, thin = 0;
   for (const Peg& peg : m.pegs)
     for (const Loop& loop : m.loops)
-      if (loop.radius >= peg.half_width + 0.001) room = std::max(room, loop.radius - peg.half_width);
-  if (room <= 0 || m.rad.cd < room) return 0;
+      if (loop.radius >= peg.half_width + 0.001) {
+        room = std::max(room, loop.radius - peg.half_width);
+        if (m.rad.cd > peg.half_width && m.rad.cd > 0.5 * loop.thickness)
+          thin = std::max(thin, std::min(peg.half_width, 0.5 * loop.thickness));
+      }
+  // The bound on the contact distance, doubled (the room's half).
+  double bound = room > 0 && m.rad.cd >= room ? room : kInf;
+  if (thin > 0) bound = std::min(bound, 2 * thin);
+  if (bound == kInf) return 0;
   // cd = r_area (1 + 1 / 1.5), r_area a step of sqrt(2) from 1 mm and at least 1.5 r
   // (sphereRadii, areaSphereRadius): the largest such r_area under the bound, r a third smaller.
-  const double r_area = 0.001 * std::pow(std::sqrt(2.0), std::floor(std::log(0.6 * 0.5 * room / 0.001) / std::log(std::sqrt(2.0))));
+  const double r_area = 0.001 * std::pow(std::sqrt(2.0), std::floor(std::log(0.6 * 0.5 * bound / 0.001) / std::log(std::sqrt(2.0))));
   const double r = std::max(r_area / 1.5, 0.00075);
   if (r >= m.rad.r) return 0;
   // Within the model memory limit (checkLimits), else as built.
@@ -660,11 +672,16 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // J-hook's wire) touches the peg on both sides in the sphere models: rebuilt finer for it.
   if (!findObjectLoops(run, *models)) return stopped(run.result, run.t0);
   if (const double r = fineRadius(run, *models); r > 0) {
+    // The pegs and loops are the meshes' geometry, found once: on the finer area model the
+    // pegs' probes sample other tops (a J-hook's arm rising 15 degrees came out at 13.5, not
+    // 20, and a basket threaded on the first no longer threaded).
     std::vector<Loop> loops = std::move(models->loops);
+    std::vector<Peg> pegs = std::move(models->pegs);
     run.result.warnings.resize(warnings);  // said again by the second build
     models = buildModels(run, *cache_, r);
     if (!models) return stopped(run.result, run.t0);
     models->loops = std::move(loops);
+    models->pegs = std::move(pegs);
   }
   // ---- floor points (IV-B) and start orientations (IV-A): the roots
   const std::optional<Roots> roots = findRoots(run, *models);

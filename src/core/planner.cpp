@@ -393,9 +393,6 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache, double r 
                              m.object_small = decimated(run.object, max_tri, &m.object_cell, &run.stop);
                            m.om = buildObjectModel(m.searched(run.object), m.rad.r, &run.stop);
                            m.am = area_model.get();
-                           // Where the area has pegs, a hanging pose's guard probes the object's
-                           // long faces (penetration.h).
-                           if (!m.pegs.empty()) addProbes(m.om, 4.0 * m.rad.r);
                            return true;
                          },
                          run.stop, run.setup_going)
@@ -682,6 +679,13 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     if (!models) return stopped(run.result, run.t0);
     models->loops = std::move(loops);
     models->pegs = std::move(pegs);
+  }
+  // Where the area has pegs, a hanging pose's guard probes the object's long faces
+  // (penetration.h), on the models searched.
+  if (!models->pegs.empty()) {
+    const auto tp = Clock::now();
+    addProbes(models->om, 4.0 * models->rad.r);
+    run.st().steps.setup += msSince(tp);
   }
   // ---- floor points (IV-B) and start orientations (IV-A): the roots
   const std::optional<Roots> roots = findRoots(run, *models);

@@ -589,8 +589,10 @@ void TreeStepper::tiltStep(std::vector<TreeLeaf>& leaves) {
       double a = sigma > 0 ? std::min(av[i].ccw, ae[i].ccw) : std::min(av[i].cw, ae[i].cw);
       const double sw = sigma > 0 ? swing[i].first : swing[i].second;
       if (sw < a) a = sw;  // it swings to rest before anything stops it
-      if (kTrace)
+      if (kTrace && a < kInf)
         std::fprintf(stderr, "root %d depth %d sigma %d angle %.2f deg\n", n.root, n.depth, sigma, a * 180 / M_PI);
+      else if (kTrace)
+        std::fprintf(stderr, "root %d depth %d sigma %d angle none (blocked or free)\n", n.root, n.depth, sigma);
       if (a >= kInf) continue;  // blocked, or turns freely: no resting pose that way
       TreeNode c;
       c.X_GO = rotatedAbout(n.X_GO, n.s_A, n.d_A, sigma * a);

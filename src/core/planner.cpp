@@ -189,15 +189,16 @@ auto runStoppable(F&& step, StopSignal& stop, const std::function<bool()>& keep_
   }
 }
 
-// Bounded work (work_limits.h): sizes that say "millimetres", model memory; before any model.
-// Both models are estimated, the area's even when cached (one that is over the limit was never
-// built): O(triangles), no hash of the area on top of the cache's own.
 // The sphere models' estimated memory (MB) at these radii.
 double modelMegabytes(const Mesh& object, const Mesh& area, const Radii& rad, const PlannerConfig& config) {
   const size_t max_tri = static_cast<size_t>(config.max_triangles);
   return (estimateModelBytes(object, rad.r, 0, 0, max_tri) + estimateModelBytes(area, rad.r_area, rad.cd, rad.cell, max_tri)) /
          (1024.0 * 1024.0);
 }
+
+// Bounded work (work_limits.h): sizes that say "millimetres", model memory; before any model.
+// Both models are estimated, the area's even when cached (one that is over the limit was never
+// built): O(triangles), no hash of the area on top of the cache's own.
 
 void checkLimits(const Mesh& object, const Mesh& area, const Radii& rad, const PlannerConfig& config,
                  PlanResult& result) {
@@ -450,13 +451,13 @@ double fineRadius(const PlanRun& run, const Models& m) {
         if (m.rad.cd > peg.half_width && m.rad.cd > 0.5 * loop.thickness)
           thin = std::max(thin, std::min(peg.half_width, 0.5 * loop.thickness));
       }
-  // The bound on the contact distance, doubled (the room's half).
-  double bound = room > 0 && m.rad.cd >= room ? room : kInf;
-  if (thin > 0) bound = std::min(bound, 2 * thin);
-  if (bound == kInf) return 0;
+  // The largest contact distance that serves.
+  double cd_max = room > 0 && m.rad.cd >= room ? 0.5 * room : kInf;
+  if (thin > 0) cd_max = std::min(cd_max, thin);
+  if (cd_max == kInf) return 0;
   // cd = r_area (1 + 1 / 1.5), r_area a step of sqrt(2) from 1 mm and at least 1.5 r
   // (sphereRadii, areaSphereRadius): the largest such r_area under the bound, r a third smaller.
-  const double r_area = 0.001 * std::pow(std::sqrt(2.0), std::floor(std::log(0.6 * 0.5 * bound / 0.001) / std::log(std::sqrt(2.0))));
+  const double r_area = 0.001 * std::pow(std::sqrt(2.0), std::floor(std::log(0.6 * cd_max / 0.001) / std::log(std::sqrt(2.0))));
   const double r = std::max(r_area / 1.5, 0.00075);
   if (r >= m.rad.r) return 0;
   // Within the model memory limit (checkLimits), else as built.

@@ -121,11 +121,13 @@ TEST(Hanging, MugHangsOnRisingPegsLeaningOnTheWall) {
 }
 
 // The best candidate of `object` on `area` with placement hanging: stable and hanging; none (a
-// failure) when nothing stable hangs there.
-std::optional<Candidate> bestHung(const Mesh& object, const Mesh& area) {
+// failure) when nothing stable hangs there. `max_radius` > 0: the sphere models were built finer
+// than that for the object's loop (fineRadius).
+std::optional<Candidate> bestHung(const Mesh& object, const Mesh& area, double max_radius = 0) {
   PlannerConfig c = twoThreads();
   c.placement = PlacementKind::kHanging;
   const PlanResult r = Planner().plan(object, area, c);
+  if (max_radius > 0) EXPECT_LT(r.stats.sphere_radius, max_radius) << "the models were not built finer for the loop";
   EXPECT_GT(r.stableCount(), 0) << "it hangs nowhere";
   if (r.stableCount() == 0 || !r.candidates.front().stable) return std::nullopt;
   EXPECT_TRUE(r.candidates.front().hanging);
@@ -310,21 +312,6 @@ TEST(Hanging, YcbMugTurnsItsBodyOutFromTheWallToPassAShortJHooksTip) {
   expectStillHangsInBullet(mug, hooks, *best);
 }
 
-// The best candidate of `object` on `area` with placement hanging, on sphere models built finer
-// than `max_radius` for its loop (fineRadius): stable, hanging, threaded on a peg; none (a
-// failure) when nothing stable hangs there.
-std::optional<Candidate> bestHungOnFinerModels(const Mesh& object, const Mesh& area, double max_radius) {
-  PlannerConfig c = twoThreads();
-  c.placement = PlacementKind::kHanging;
-  const PlanResult r = Planner().plan(object, area, c);
-  EXPECT_LT(r.stats.sphere_radius, max_radius) << "the models were not built finer for the loop";
-  EXPECT_GT(r.stableCount(), 0) << "it hangs nowhere";
-  if (r.stableCount() == 0 || !r.candidates.front().stable) return std::nullopt;
-  EXPECT_TRUE(r.candidates.front().hanging);
-  EXPECT_EQ(r.candidates.front().start, StartKind::kLoopOnPeg);
-  return r.candidates.front();
-}
-
 // A pan 20 cm across with a slot 2 cm wide and 4 cm long through its handle's end, on two J-hooks
 // of 8 mm wire (not in the suite): out 5 cm rising 10 degrees, the tip turned up 2 cm. The slot
 // leaves 6 mm either side of the wire, under the contact distance of the pan's default sphere
@@ -337,9 +324,10 @@ TEST(Hanging, APanHangsByTheSlotInItsHandleOnAJHook) {
   for (const double x : {0.2025, 0.255}) pan_parts.push_back(scenes::box(x < 0.25 ? 0.015 : 0.01, 0.04, 0.012, {x, 0, 0.031}));
   const Mesh pan = scenes::merge(pan_parts, "pan");
   const Mesh hooks = wallJHooks(0.004);
-  const std::optional<Candidate> hung = bestHungOnFinerModels(pan, hooks, 0.002);
+  const std::optional<Candidate> hung = bestHung(pan, hooks, 0.002);
   ASSERT_TRUE(hung);
   const Candidate& best = *hung;
+  EXPECT_EQ(best.start, StartKind::kLoopOnPeg);
   // Held from the arm (above the centre of mass, within the wire's reach of a hook's line).
   const Eigen::Vector3d com = best.X_WO * pan.properties.center_of_mass;
   int on_arm = 0;
@@ -387,9 +375,10 @@ TEST(Hanging, ABasketHangsByItsArchedHandleOnACupHooksThinWire) {
     parts.push_back(rod({x, -0.04, 0.33}, {x, -0.04, 0.355}, 0.003));
   }
   const Mesh hooks = scenes::merge(parts, "shelf_cup_hooks");
-  const std::optional<Candidate> hung = bestHungOnFinerModels(basket, hooks, 0.0015);
+  const std::optional<Candidate> hung = bestHung(basket, hooks, 0.0015);
   ASSERT_TRUE(hung);
   const Candidate& best = *hung;
+  EXPECT_EQ(best.start, StartKind::kLoopOnPeg);
   // Held from an arm, its centre of mass straight below (within 5 mm) the middle of those contacts.
   const Eigen::Vector3d com = best.X_WO * basket.properties.center_of_mass;
   Eigen::Vector3d mid = Eigen::Vector3d::Zero();

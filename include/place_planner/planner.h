@@ -117,6 +117,7 @@ struct PlanStats {
   int pegs = 0;                    // the area's pegs (search/pegs.h), when hanging is searched
   int loops = 0;                   // the object's loops (search/loops.h), when pegs were found
   int hanging_starts = 0;          // loop-on-peg roots threaded free
+  int hanging_starts_done = 0;     // ... whose trees are done (the progress of a hanging search)
   int start_orientations = 0;
   int spikes_flattened = 0;        // vertices of a scanned object moved onto their neighbours' plane (model/despike.h)
   int roll_bottoms = 0;            // leaves at the bottom of a roll (tree_stepper rollStep), stable or not
@@ -163,7 +164,9 @@ struct PlanResult {
 
 struct Progress {
   int floor_points_done = 0;
-  int floor_points_total = 0;
+  int floor_points_total = 0;  // searched: 0 with placement hanging (the roots are threaded starts)
+  int hanging_starts_done = 0;   // threaded starts (loop on peg) whose trees are done ...
+  int hanging_starts_total = 0;  // ... of these; 0 with placement standing or nothing to hang on
   double best_quality = 0.0;  // of stable candidates so far; 0 when none
   int candidates = 0;
   double elapsed_ms = 0.0;

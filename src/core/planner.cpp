@@ -159,6 +159,16 @@ RobustnessParams robustnessParams(const PlannerConfig& config, bool scanned) {
 
 // Between steps and while a setup step runs: false once the budget (`limit`, ms; 0 = none) is
 // spent or the caller cancels through the progress callback (called on the planner's thread).
+// "F of N floor points", "H of M threaded starts", or both: what a search has done so far.
+std::string searchedSoFar(const PlanStats& st, bool floor_points) {
+  std::string s;
+  if (floor_points) s = std::to_string(st.floor_points_done) + " of " + std::to_string(st.floor_points_total) + " floor points";
+  if (st.hanging_starts > 0)
+    s += (s.empty() ? "" : " and ") + std::to_string(st.hanging_starts_done) + " of " +
+         std::to_string(st.hanging_starts) + " threaded starts";
+  return s.empty() ? "0 of 0 floor points" : s;  // stopped before any root was found
+}
+
 bool keepGoing(Clock::time_point t0, double limit, const ProgressCallback& progress, Progress p,
                PlanResult& result) {
   if (limit > 0 && msSince(t0) > limit) return !(result.timed_out = true);
@@ -256,7 +266,8 @@ struct SearchMonitor {
   bool keepGoing(double limit) {
     const PlanStats& st = result.stats;
     return place_planner::keepGoing(t0, limit, progress,
-                                    Progress{st.floor_points_done, st.floor_points_total, best_q, stable_count, 0},
+                                    Progress{st.floor_points_done, orientations > 0 ? st.floor_points_total : 0,
+                                             st.hanging_starts_done, st.hanging_starts, best_q, stable_count, 0},
                                     result);
   }
 
@@ -305,11 +316,14 @@ struct SearchMonitor {
         ++stable_count;
         best_q = std::max(best_q, all[fresh[j]].quality);
       }
-    st.floor_points_done = std::max(0, started - open - hanging) / std::max(1, orientations);
+    // The hanging roots come first (root_search.h): trees done count against them, then
+    // against the floor points (each with its start orientations).
+    const int done = std::max(0, started - open);
+    st.hanging_starts_done = std::min(done, hanging);
+    st.floor_points_done = std::max(0, done - hanging) / std::max(1, orientations);
     if (st.tree_nodes >= config.max_tree_nodes) {
       result.warnings.push_back("search stopped after max_tree_nodes = " + std::to_string(config.max_tree_nodes) +
-                                " poses; " + std::to_string(st.floor_points_done) + " of " +
-                                std::to_string(st.floor_points_total) + " floor points done");
+                                " poses; " + searchedSoFar(st, orientations > 0) + " done");
       return false;
     }
     return keepGoing(search_budget);

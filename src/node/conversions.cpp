@@ -238,6 +238,8 @@ void toMsg(const Candidate& c, const std::string& frame_id, const std::string& g
 void toMsg(const Progress& p, PlacePlanFeedback* msg) {
   msg->floor_points_done = p.floor_points_done;
   msg->floor_points_total = p.floor_points_total;
+  msg->hanging_starts_done = p.hanging_starts_done;
+  msg->hanging_starts_total = p.hanging_starts_total;
   msg->candidates_so_far = p.candidates;
   msg->best_quality = p.best_quality;
   msg->elapsed_time = p.elapsed_ms / 1000.0;

@@ -323,6 +323,7 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
     toMsg(plan.candidates[i], config_.planning_frame, gripper_frame, answer->stamp, &result.candidates[i]);
   }
   result.floor_points_evaluated = plan.stats.floor_points_done;
+  result.hanging_starts_evaluated = plan.stats.hanging_starts_done;
   result.trees_without_rest = plan.stats.trees_without_rest;
   result.gripper_rejected = plan.stats.gripper_rejected;
   result.gripper_tilt_rejected = plan.stats.gripper_tilt_rejected;
@@ -330,9 +331,14 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   result.partial = false;
   const int n_stable = plan.stableCount();
   std::ostringstream summary;
-  summary << plan.candidates.size() << " candidates (" << n_stable << " stable) from "
-          << plan.stats.floor_points_done << " of " << plan.stats.floor_points_total
-          << " floor points in " << (ros::WallTime::now() - plan_start_).toSec() << " s"
+  summary << plan.candidates.size() << " candidates (" << n_stable << " stable) from ";
+  if (plan.stats.start_orientations > 0)
+    summary << plan.stats.floor_points_done << " of " << plan.stats.floor_points_total << " floor points";
+  if (plan.stats.hanging_starts > 0)
+    summary << (plan.stats.start_orientations > 0 ? " and " : "") << plan.stats.hanging_starts_done << " of "
+            << plan.stats.hanging_starts << " threaded starts";
+  if (plan.stats.start_orientations == 0 && plan.stats.hanging_starts == 0) summary << "0 of 0 floor points";
+  summary << " in " << (ros::WallTime::now() - plan_start_).toSec() << " s"
           << physics_summary;
   if (prepared.config.has_grasp) {
     summary << "; gripper: " << plan.stats.gripper_rejected << " candidates blocked, "

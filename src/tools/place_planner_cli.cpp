@@ -178,8 +178,12 @@ class ProgressLine {
     if (shown_ && now - last_ < std::chrono::milliseconds(200)) return true;
     last_ = now;
     shown_ = true;
-    std::fprintf(stderr, "\rplanning: floor points %d of %d, %d stable so far, %.1f s\033[K", p.floor_points_done,
-                 p.floor_points_total, p.candidates, p.elapsed_ms / 1000.0);
+    std::string done;
+    if (p.floor_points_total > 0) done = "floor points " + std::to_string(p.floor_points_done) + " of " + std::to_string(p.floor_points_total);
+    if (p.hanging_starts_total > 0)
+      done += (done.empty() ? "" : ", ") + std::string("threaded starts ") + std::to_string(p.hanging_starts_done) + " of " +
+              std::to_string(p.hanging_starts_total);
+    std::fprintf(stderr, "\rplanning: %s, %d stable so far, %.1f s\033[K", done.c_str(), p.candidates, p.elapsed_ms / 1000.0);
     std::fflush(stderr);
     return true;
   }
@@ -238,6 +242,8 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
   j["first_stable_ms"] = st.first_stable_ms;
   j["floor_points"] = st.floor_points_total;
   j["floor_points_done"] = st.floor_points_done;
+  j["hanging_starts"] = st.hanging_starts;
+  j["hanging_starts_done"] = st.hanging_starts_done;
   j["tree_nodes"] = st.tree_nodes;
   j["trees_without_rest"] = st.trees_without_rest;  // cut by max_rotations while still tilting
   j["spikes_flattened"] = st.spikes_flattened;      // noise spikes of a scanned object flattened
@@ -310,12 +316,16 @@ void printReport(const std::string& object_spec, const Mesh& object, const std::
   std::printf("object %s (%zu triangles), area %s (%zu triangles), orientation %s\n", object_spec.c_str(),
               object.triangles.size(), area_spec.c_str(), area.triangles.size(), toString(c.orientation).c_str());
   // The times block names the backend once: the CPU is the normal case for `auto`, not a warning.
-  std::printf("floor points %d of %d, tree nodes %ld, planning %.1f ms, first stable %.1f ms, %s backend\n",
-              st.floor_points_done, st.floor_points_total, st.tree_nodes, st.total_ms, st.first_stable_ms,
-              st.backend == "cuda" ? "CUDA" : "CPU");
+  // With placement hanging the floor points are found (the answer lists them) but not searched.
+  if (st.start_orientations > 0)
+    std::printf("floor points %d of %d, ", st.floor_points_done, st.floor_points_total);
+  else
+    std::printf("floor points not searched (no start orientation), ");
+  std::printf("tree nodes %ld, planning %.1f ms, first stable %.1f ms, %s backend\n", st.tree_nodes, st.total_ms,
+              st.first_stable_ms, st.backend == "cuda" ? "CUDA" : "CPU");
   if (st.pegs > 0)
-    std::printf("hanging: %d pegs on the area, %d loops of the object, %d threaded starts\n", st.pegs, st.loops,
-                st.hanging_starts);
+    std::printf("hanging: %d pegs on the area, %d loops of the object, %d threaded starts (%d searched)\n", st.pegs,
+                st.loops, st.hanging_starts, st.hanging_starts_done);
   if (st.trees_without_rest > 0 || st.roll_bottoms > 0 || st.trees_fallen > 0)
     std::printf("trees: %d cut by max_rotations while still tilting, %d ended at the bottom of a roll, "
                 "%d cut while falling over a ledge\n",
@@ -341,6 +351,18 @@ void printTable(const PlanResult& r) {
   }
 }
 
+// What the search covered: "F of N floor points", "H of M threaded starts" (placement hanging:
+// the floor points are not searched), or both.
+std::string searched(const PlanStats& st) {
+  std::string s;
+  if (st.start_orientations > 0)
+    s = std::to_string(st.floor_points_done) + " of " + std::to_string(st.floor_points_total) + " floor points";
+  if (st.hanging_starts > 0)
+    s += (s.empty() ? "" : " and ") + std::to_string(st.hanging_starts_done) + " of " +
+         std::to_string(st.hanging_starts) + " threaded starts";
+  return s.empty() ? "0 of 0 floor points" : s;  // stopped before any root was found
+}
+
 // The answer in one line, always last on stdout (scripts read it with tail -1).
 void printOutcome(const PlannerConfig& c, const PlanResult& r) {
   const auto& st = r.stats;
@@ -351,19 +373,19 @@ void printOutcome(const PlannerConfig& c, const PlanResult& r) {
       std::printf("outcome: stable (%d stable candidate%s)\n", n_stable, n_stable == 1 ? "" : "s");
       break;
     case PlanOutcome::kTimedOutWithStable:
-      std::printf("partial answer: the time budget of %.1f ms ran out after %d of %d floor points\n",
-                  c.time_budget_ms, st.floor_points_done, st.floor_points_total);
+      std::printf("partial answer: the time budget of %.1f ms ran out after %s\n", c.time_budget_ms,
+                  searched(st).c_str());
       std::printf("outcome: timed_out_partial (%d stable candidate%s so far)\n", n_stable,
                   n_stable == 1 ? "" : "s");
       break;
     case PlanOutcome::kNoStable:
-      std::printf("outcome: no_stable_pose (%zu candidates, none stable, all %d floor points searched)\n",
-                  r.candidates.size(), st.floor_points_total);
+      std::printf("outcome: no_stable_pose (%zu candidates, none stable, %s searched)\n", r.candidates.size(),
+                  searched(st).c_str());
       break;
     case PlanOutcome::kTimedOutNone:
     case PlanOutcome::kCancelled:
-      std::printf("outcome: %s (nothing stable in %d of %d floor points within %.1f ms)\n", toString(outcome),
-                  st.floor_points_done, st.floor_points_total, c.time_budget_ms);
+      std::printf("outcome: %s (nothing stable in %s within %.1f ms)\n", toString(outcome), searched(st).c_str(),
+                  c.time_budget_ms);
       break;
   }
 }

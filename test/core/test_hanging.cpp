@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -169,6 +170,46 @@ TEST(Placement, KindChoosesStandingOrHanging) {
   ASSERT_GT(table_any.stableCount(), 0);
   EXPECT_TRUE(table_any.candidates.front().X_WO.isApprox(table_standing.candidates.front().X_WO, 1e-9));
   EXPECT_THROW(placementKindFromString("dangling"), std::invalid_argument);
+}
+
+// A hanging search's roots are threaded starts, not floor points: its progress counts them
+// (a progress bar stuck at "0 of 33 floor points" for seconds says nothing), up to all of them
+// when the search ends; standing and hanging together, both count.
+TEST(Placement, ProgressCountsThreadedStarts) {
+  const Mesh ring = scenes::torus(0.03, 0.006);
+  PlannerConfig c;
+  c.threads = 2;
+  c.placement = PlacementKind::kHanging;
+  std::vector<Progress> seen;
+  const PlanResult r = Planner().plan(ring, scenes::pegWall(), c, [&](const Progress& p) {
+    seen.push_back(p);
+    return true;
+  });
+  ASSERT_GT(r.stats.hanging_starts, 0);
+  EXPECT_EQ(r.stats.hanging_starts_done, r.stats.hanging_starts);
+  EXPECT_EQ(r.stats.start_orientations, 0);
+  // While the models are built the roots are not known yet: those reports say 0 of 0.
+  seen.erase(seen.begin(), std::find_if(seen.begin(), seen.end(), [](const Progress& p) { return p.hanging_starts_total > 0; }));
+  ASSERT_GE(seen.size(), 2u) << "reports while the trees grow";
+  for (size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].floor_points_total, 0) << "floor points are not searched with placement hanging";
+    EXPECT_EQ(seen[i].hanging_starts_total, r.stats.hanging_starts);
+    EXPECT_LE(seen[i].hanging_starts_done, seen[i].hanging_starts_total);
+    if (i > 0) EXPECT_GE(seen[i].hanging_starts_done, seen[i - 1].hanging_starts_done);
+  }
+  EXPECT_LT(seen.front().hanging_starts_done, r.stats.hanging_starts);
+  EXPECT_EQ(seen.back().hanging_starts_done, r.stats.hanging_starts);
+  c.placement = PlacementKind::kAny;
+  seen.clear();
+  const PlanResult any = Planner().plan(ring, scenes::pegWall(), c, [&](const Progress& p) {
+    seen.push_back(p);
+    return true;
+  });
+  ASSERT_FALSE(seen.empty());
+  EXPECT_GT(seen.back().floor_points_total, 0);
+  EXPECT_EQ(seen.back().hanging_starts_total, any.stats.hanging_starts);
+  EXPECT_EQ(any.stats.hanging_starts_done, any.stats.hanging_starts);
+  EXPECT_EQ(any.stats.floor_points_done, any.stats.floor_points_total);
 }
 
 // A mug hung on a mug tree whose arms rise 35 degrees slides down its arm until its body meets

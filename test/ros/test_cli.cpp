@@ -467,6 +467,12 @@ TEST(PlacePlannerCli, PlacementHangingIsChosenAndReported) {
   EXPECT_EQ(j.at("candidates")[0].at("kind"), "hanging");
   EXPECT_EQ(j.at("candidates")[0].at("start"), "loop_on_peg");
   EXPECT_TRUE(contains(r.err, "hanging: 6 pegs on the area, 1 loops of the object")) << r.err;
+  // Its roots are the threaded starts, all searched; the floor points are not.
+  const int starts = j.at("hanging_starts");
+  EXPECT_GT(starts, 0);
+  EXPECT_EQ(j.at("hanging_starts_done"), starts);
+  EXPECT_TRUE(contains(r.err, "floor points not searched")) << r.err;
+  EXPECT_TRUE(contains(r.err, "threaded starts (" + std::to_string(starts) + " searched)")) << r.err;
   const CliRun standing = cli({"--object", "builtin:ring", "--area", "builtin:peg_wall", "--placement", "standing",
                                "--threads", "2", "--json", "-"});
   ASSERT_TRUE(json::accept(standing.out)) << standing.out.substr(0, 200);

@@ -149,14 +149,20 @@ def j_hooks(out, name, reach, rise_deg, tip, wire):
 
 
 def summarize(path):
-    """'outcome checked stayed best_stayed planning_ms' of a CLI --json answer checked with
-    --verify: --verify moves a checked candidate that fell behind the stable ones, so the
-    planner's rank says which was best."""
+    """'outcome checked stayed best_stayed planning_ms bullet_best mujoco_best' of a CLI --json
+    answer checked with --verify: --verify moves a checked candidate that fell behind the stable
+    ones, so the planner's rank says which was best. stayed: in every engine --verify-engines
+    asked; bullet_best / mujoco_best: the best kept by that engine alone (-1: not asked)."""
     try:
         d = json.load(open(path))
     except Exception:
-        return "failed 0 0 0 0"
+        return "failed 0 0 0 0 -1 -1"
     c = sorted((x for x in d["candidates"] if x["stable"] and x["physics"]["checked"]),
                key=lambda x: x["physics"]["planner_rank"])
-    return "%s %d %d %d %.0f" % (d["outcome"], len(c), sum(x["physics"]["stayed"] for x in c),
-                                 int(bool(c) and c[0]["physics"]["stayed"]), d["planning_ms"])
+    def best_by(engine):
+        if not c or not c[0]["physics"].get(engine, {}).get("checked", False):
+            return -1
+        return int(c[0]["physics"][engine]["stayed"])
+    return "%s %d %d %d %.0f %d %d" % (d["outcome"], len(c), sum(x["physics"]["stayed"] for x in c),
+                                       int(bool(c) and c[0]["physics"]["stayed"]), d["planning_ms"],
+                                       best_by("bullet"), best_by("mujoco"))

@@ -32,13 +32,21 @@ struct Robustness {
   double share() const { return trials > 0 ? static_cast<double>(held) / trials : 0.0; }
 };
 
-// A physics engine's verdict (Bullet, validation::verifyTopK; filled by the CLI and the node
-// when verify_top_k > 0, never by the core planner).
+// The physics engines' verdict (Bullet, and MuJoCo when asked: validation::verifyTopK; filled by
+// the CLI and the node when verify_top_k > 0, never by the core planner).
 struct PhysicsCheck {
   bool checked = false;   // false: not simulated (not in the top K, or out of time)
-  bool stayed = false;    // moved < 1 cm and turned < 5 degrees after release
-  double moved_m = 0.0;
+  bool stayed = false;    // moved < 1 cm and turned < 5 degrees after release, in every engine asked
+  double moved_m = 0.0;   // Bullet's (MuJoCo's when it was the only engine asked)
   double turned_deg = 0.0;
+  // Each engine's own verdict, when it was asked (validation::Engines): Bullet's moved_m and
+  // turned_deg are those above; MuJoCo is the second engine.
+  bool bullet_checked = false;
+  bool bullet_stayed = false;
+  bool mujoco_checked = false;
+  bool mujoco_stayed = false;
+  double mujoco_moved_m = 0.0;
+  double mujoco_turned_deg = 0.0;
   // The candidate's place in the planner's ranking (set by validation::verifyTopK, which moves a
   // candidate that fell behind the stable ones that did not, so the list may differ from it).
   int planner_rank = -1;

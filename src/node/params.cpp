@@ -199,6 +199,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("marker_candidates", &c.marker_candidates);
   r.read("marker_text_count", &c.marker_text_count);
   r.read("verify_top_k", &c.verify_top_k);
+  r.read("verify_engines", &c.verify_engines);
   if (c.planning_frame.empty()) r.fail("planning_frame", "must not be empty");
   if (!(c.tf_timeout >= 0 && c.tf_timeout <= 60)) r.fail("tf_timeout", "is out of range (0 .. 60 s)");
   if (!(c.feedback_period > 0 && c.feedback_period <= 0.1)) {
@@ -209,6 +210,8 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   if (c.verify_top_k < 0 || c.verify_top_k > 100) {
     r.fail("verify_top_k", "is out of range (0 .. 100, 0 = off)");
   }
+  if (c.verify_engines != "bullet" && c.verify_engines != "mujoco" && c.verify_engines != "both")
+    r.fail("verify_engines", "'" + c.verify_engines + "' is none of bullet, mujoco, both");
 
   // PlannerConfig, field for field (include/place_planner/config.h).
   PlannerConfig& p = c.planner;

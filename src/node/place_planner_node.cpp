@@ -303,9 +303,10 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
       const validation::VerifyStats v = validation::verifyTopK(
           prepared.object_O, prepared.area_W, prepared.config, plan, prepared.verify_top_k,
           validation::remainingBudgetMs(prepared.config.time_budget_ms, plan.stats.total_ms),
-          prepared.config.threads, [this] { return ros::ok() && !preempt_requested_; });
+          prepared.config.threads, [this] { return ros::ok() && !preempt_requested_; },
+          validation::enginesFromString(config_.verify_engines));
       std::ostringstream os;
-      os << "; physics: " << v.stayed << " of " << v.checked << " checked stayed ("
+      os << "; physics (" << config_.verify_engines << "): " << v.stayed << " of " << v.checked << " checked stayed ("
          << v.selected - v.checked << " not checked, " << v.total_ms << " ms)";
       physics_summary = os.str();
     } catch (const std::exception& e) {

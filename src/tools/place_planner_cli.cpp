@@ -52,7 +52,8 @@ const char* kFooter =
     "auto plans on CUDA where a GPU answers, else on the CPU.\n"
     "--verify K: simulate the best K stable candidates in Bullet (released 2 mm above the pose;\n"
     "stayed = moved < 1 cm, turned < 5 deg) within what is left of --budget-ms; one that falls is\n"
-    "moved behind the other stable candidates.\n"
+    "moved behind the other stable candidates. --verify-engines both: the same check in MuJoCo too\n"
+    "(about a second more per candidate); a candidate stayed when both engines kept it.\n"
     "--json OUT: a regular file is replaced atomically (a temporary file beside it, then\n"
     "rename); a device, FIFO or socket (/dev/null, a named pipe) is written in place; a symlink's\n"
     "target is replaced; --json - writes the JSON to stdout and the report to stderr.\n"
@@ -281,7 +282,13 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
           {"stayed", k.physics.stayed},
           {"moved_m", k.physics.moved_m},
           {"turned_deg", k.physics.turned_deg},
-          {"planner_rank", k.physics.planner_rank}}},
+          {"planner_rank", k.physics.planner_rank},
+          {"bullet", {{"checked", k.physics.bullet_checked}, {"stayed", k.physics.bullet_stayed}}},
+          {"mujoco",
+           {{"checked", k.physics.mujoco_checked},
+            {"stayed", k.physics.mujoco_stayed},
+            {"moved_m", k.physics.mujoco_moved_m},
+            {"turned_deg", k.physics.mujoco_turned_deg}}}}},
         {"floor_point", vecJson(k.floor_point_W)},
         {"contacts", contacts},
         {"intermediate_poses", poses},
@@ -492,6 +499,11 @@ int main(int argc, char** argv) {
   app.add_option("--verify", verify_k, "physics check of the best K stable candidates, 0 = off")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  std::string engines_name = "bullet";
+  app.add_option("--verify-engines", engines_name, "--verify in bullet, mujoco or both (both: a pose stays when both keep it)")
+      ->check(CLI::IsMember({"bullet", "mujoco", "both"}))
+      ->capture_default_str()
+      ->type_name("ENGINES");
   app.add_option("--json", json_path, "write the answer as JSON to this file; - = stdout (the report then goes to stderr)")
       ->type_name("OUT");
   bool verbose = false;
@@ -646,10 +658,17 @@ int main(int argc, char** argv) {
     if (verify_k > 0) {
       // Within what is left of the plan's budget (none: no limit).
       const double budget = validation::remainingBudgetMs(c.time_budget_ms, r.stats.total_ms);
-      const validation::VerifyStats v = validation::verifyTopK(object, area, c, r, verify_k, budget, c.threads);
-      std::printf("physics (Bullet): %d of %d checked, %d stayed, %d moved down the ranking; "
+      const validation::Engines engines = validation::enginesFromString(engines_name);
+      const validation::VerifyStats v =
+          validation::verifyTopK(object, area, c, r, verify_k, budget, c.threads, {}, engines);
+      const char* names[] = {"Bullet", "MuJoCo", "Bullet and MuJoCo"};
+      std::printf("physics (%s): %d of %d checked, %d stayed, %d moved down the ranking; "
                   "%.1f ms (shapes %.1f ms, %.1f ms per candidate, %d threads)\n",
-                  v.checked, v.selected, v.stayed, v.demoted, v.total_ms, v.shape_ms, v.per_check_ms, v.threads);
+                  names[static_cast<int>(engines)], v.checked, v.selected, v.stayed, v.demoted, v.total_ms,
+                  v.shape_ms, v.per_check_ms, v.threads);
+      if (engines == validation::Engines::kBoth)
+        std::printf("physics by engine: Bullet kept %d, MuJoCo kept %d of %d\n", v.bullet_stayed, v.mujoco_stayed,
+                    v.checked);
     }
 #endif
 #ifdef PLACE_PLANNER_HAVE_VALIDATION

@@ -19,6 +19,7 @@
 #include "place_planner/infra/parallel_for.h"
 #include "place_planner/infra/stable_sort.h"
 #include "place_planner/search/loops.h"
+#include "place_planner/validation/mujoco_validator.h"
 
 namespace place_planner {
 namespace validation {
@@ -574,9 +575,25 @@ double remainingBudgetMs(double plan_budget_ms, double used_ms) {
   return std::max(plan_budget_ms - used_ms, 1e-6);
 }
 
+Engines enginesFromString(const std::string& s) {
+  if (s == "bullet") return Engines::kBullet;
+  if (s == "mujoco") return Engines::kMujoco;
+  if (s == "both") return Engines::kBoth;
+  throw std::invalid_argument("engines: '" + s + "' is none of bullet, mujoco, both");
+}
+
+const char* toString(Engines e) {
+  switch (e) {
+    case Engines::kBullet: return "bullet";
+    case Engines::kMujoco: return "mujoco";
+    case Engines::kBoth: return "both";
+  }
+  return "?";
+}
+
 VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerConfig& cfg,
                        PlanResult& result, int k, double budget_ms, int threads,
-                       const std::function<bool()>& keep_going) {
+                       const std::function<bool()>& keep_going, Engines engines) {
   const auto t0 = Clock::now();
   VerifyStats s;
   std::vector<Candidate>& cands = result.candidates;
@@ -603,39 +620,74 @@ VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerCo
   vc.friction = cfg.friction;
   const Eigen::Vector3d d_g = cfg.gravity.norm() > 0 ? cfg.gravity.normalized() : Eigen::Vector3d(0, 0, -1);
   vc.gravity = 9.81 * d_g;
-  const PhysicsValidator validator(object_O, area_W, vc);
-  s.shape_ms = validator.shapeBuildMs();
   // Hanging candidates: checked damped and judged by stillHanging (a pendulum turns to its rest).
   const ValidatorConfig hc = forHanging(vc);
-  std::unique_ptr<PhysicsValidator> hanging;
-  for (size_t i : picked)
-    if (cands[i].hanging && !hanging) {
-      hanging = std::make_unique<PhysicsValidator>(object_O, area_W, hc);
-      s.shape_ms += hanging->shapeBuildMs();
-    }
+  bool any_hanging = false, any_standing = false;
+  for (size_t i : picked) (cands[i].hanging ? any_hanging : any_standing) = true;
+  const bool bullet = engines != Engines::kMujoco, mujoco = engines != Engines::kBullet;
+  std::unique_ptr<PhysicsValidator> standing_b, hanging_b;
+  std::unique_ptr<MujocoValidator> standing_m, hanging_m;
+  if (bullet && any_standing) standing_b = std::make_unique<PhysicsValidator>(object_O, area_W, vc);
+  if (bullet && any_hanging) hanging_b = std::make_unique<PhysicsValidator>(object_O, area_W, hc);
+  if (mujoco && any_standing) standing_m = std::make_unique<MujocoValidator>(object_O, area_W, vc);
+  if (mujoco && any_hanging) hanging_m = std::make_unique<MujocoValidator>(object_O, area_W, hc);
+  for (const auto* v : {standing_b.get(), hanging_b.get()})
+    if (v) s.shape_ms += v->shapeBuildMs();
+  for (const auto* v : {standing_m.get(), hanging_m.get()})
+    if (v) s.shape_ms += v->buildMs();
 
   // Indices are handed out in rank order (parallel_for.h), so the best start first; the budget
-  // is read before each start.
-  std::vector<PoseCheck> checks(picked.size());
+  // is read before each start (a MuJoCo check, once started, runs to its end).
+  std::vector<PoseCheck> checks(picked.size()), mj(picked.size());
   std::vector<char> ran(picked.size(), 0);
   parallelFor(picked.size(), s.threads, [&](size_t j) {
     if (!may_start()) return;
-    checks[j] = (cands[picked[j]].hanging ? *hanging : validator).check(cands[picked[j]].X_WO, may_start);
-    ran[j] = !checks[j].interrupted;
+    const Candidate& c = cands[picked[j]];
+    if (bullet) {
+      checks[j] = (c.hanging ? *hanging_b : *standing_b).check(c.X_WO, may_start);
+      if (checks[j].interrupted) return;
+    }
+    if (mujoco) {
+      if (!may_start()) return;
+      mj[j] = (c.hanging ? *hanging_m : *standing_m).check(c.X_WO);
+    }
+    ran[j] = 1;
   });
 
   double sim_ms = 0.0;
+  const Eigen::Vector3d com_O = object_O.properties.center_of_mass;
   for (size_t j = 0; j < picked.size(); ++j) {
     if (!ran[j]) continue;
     PhysicsCheck& p = cands[picked[j]].physics;
-    p.checked = true;
     const Candidate& c = cands[picked[j]];
-    p.stayed = c.hanging ? stillHanging(checks[j], c.X_WO, object_O.properties.center_of_mass, hc) : checks[j].confirmed;
-    p.moved_m = checks[j].moved_m;
-    p.turned_deg = checks[j].turned_deg;
+    p.checked = true;
+    p.stayed = true;
+    if (bullet) {
+      const bool kept = c.hanging ? stillHanging(checks[j], c.X_WO, com_O, hc) : checks[j].confirmed;
+      p.stayed = kept;
+      p.bullet_checked = true;
+      p.bullet_stayed = kept;
+      p.moved_m = checks[j].moved_m;
+      p.turned_deg = checks[j].turned_deg;
+      s.bullet_stayed += kept;
+      sim_ms += checks[j].wall_ms;
+    }
+    if (mujoco) {
+      const bool kept = c.hanging ? stillHanging(mj[j], c.X_WO, com_O, hc) : mj[j].confirmed;
+      p.mujoco_checked = true;
+      p.mujoco_stayed = kept;
+      p.mujoco_moved_m = mj[j].moved_m;
+      p.mujoco_turned_deg = mj[j].turned_deg;
+      if (!bullet) {
+        p.moved_m = mj[j].moved_m;
+        p.turned_deg = mj[j].turned_deg;
+      }
+      p.stayed = p.stayed && kept;
+      s.mujoco_stayed += kept;
+      sim_ms += mj[j].wall_ms;
+    }
     ++s.checked;
     s.stayed += p.stayed;
-    sim_ms += checks[j].wall_ms;
   }
   s.per_check_ms = s.checked > 0 ? sim_ms / s.checked : 0.0;
 

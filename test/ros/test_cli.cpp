@@ -133,6 +133,30 @@ std::vector<std::string> cubeOnTable(const std::vector<std::string>& more) {
   return a;
 }
 
+// --verify-engines both: each checked candidate simulated in Bullet and in MuJoCo, each engine's
+// verdict in the JSON (a cube on its face stays in both); by default Bullet alone.
+TEST(PlacePlannerCli, VerifyInBothEnginesReportsEachVerdict) {
+  const CliRun r = cli(cubeOnTable({"--verify", "1", "--verify-engines", "both", "--json", "-"}));
+  EXPECT_EQ(r.code, 0) << r.err;
+  ASSERT_TRUE(json::accept(r.out)) << r.out.substr(0, 200);
+  const json best = json::parse(r.out).at("candidates").at(0).at("physics");
+  EXPECT_TRUE(best.at("checked").get<bool>());
+  EXPECT_TRUE(best.at("bullet").at("checked").get<bool>());
+  EXPECT_TRUE(best.at("mujoco").at("checked").get<bool>());
+  EXPECT_TRUE(best.at("bullet").at("stayed").get<bool>());
+  EXPECT_TRUE(best.at("mujoco").at("stayed").get<bool>());
+  EXPECT_LT(best.at("mujoco").at("moved_m").get<double>(), 0.01);
+  EXPECT_TRUE(best.at("stayed").get<bool>());
+  EXPECT_TRUE(contains(r.err, "physics (Bullet and MuJoCo): 1 of 1 checked, 1 stayed")) << r.err;
+  EXPECT_TRUE(contains(r.err, "Bullet kept 1, MuJoCo kept 1 of 1")) << r.err;
+  // Bullet alone (the default): MuJoCo not asked.
+  const CliRun b = cli(cubeOnTable({"--verify", "1", "--json", "-"}));
+  ASSERT_TRUE(json::accept(b.out)) << b.out.substr(0, 200);
+  const json only = json::parse(b.out).at("candidates").at(0).at("physics");
+  EXPECT_TRUE(only.at("bullet").at("checked").get<bool>());
+  EXPECT_FALSE(only.at("mujoco").at("checked").get<bool>());
+}
+
 TEST(PlacePlannerCli, StablePoseExitsZeroWithOutcomeLineAndVerifiedTopTwo) {
   const std::string path = tempPath("cube_table.json");
   const CliRun r = cli(cubeOnTable({"--verify", "2", "--json", path}));
@@ -212,6 +236,7 @@ TEST(PlacePlannerCli, BadInputExitsTwoNamingTheFlag) {
       {cubeOnTable({"--orientation", "upside_down"}), "--orientation"},
       {cubeOnTable({"--backend", "quantum"}), "--backend"},
       {cubeOnTable({"--verify", "-1"}), "--verify"},
+      {cubeOnTable({"--verify", "1", "--verify-engines", "havok"}), "--verify-engines"},
       {cubeOnTable({"--no-such-option", "1"}), "--no-such-option"},
       {{"--object", "builtin:cube"}, "--area"},
       {{"--object", "builtin:nothing", "--area", "builtin:table"}, "--object"},

@@ -1101,6 +1101,15 @@ TEST(PlacePlannerParams, OutOfRangeAndWrongTypeAreNamed) {
     EXPECT_NE(std::string(e.what()).find("/params_test/verify_top_k"), std::string::npos) << e.what();
   }
   nh.setParam("verify_top_k", 3);
+  nh.setParam("verify_engines", std::string("havok"));
+  try {
+    loadNodeConfig(nh);
+    ADD_FAILURE() << "verify_engines havok accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/params_test/verify_engines"), std::string::npos) << e.what();
+  }
+  nh.setParam("verify_engines", std::string("both"));
+  EXPECT_EQ(loadNodeConfig(nh).verify_engines, "both");
   nh.setParam("robust_check", 1.5);
   try {
     loadNodeConfig(nh);

@@ -416,6 +416,47 @@ TEST(VerifyTopK, CubeTiltedOnACornerFallsAndMovesDownTheRanking) {
   EXPECT_EQ(r.candidates[2].physics.planner_rank, 2);
 }
 
+// The same two candidates checked in both engines (Engines::kBoth): each engine's own verdict is
+// kept, the cube on its corner falls in both, the flat one stays in both, and stayed is both.
+TEST(VerifyTopK, BothEnginesGiveTheirOwnVerdictsAndStayedNeedsBoth) {
+  const Mesh object = cube();
+  Eigen::Isometry3d X_tilted = Eigen::Isometry3d::Identity();
+  X_tilted.linear() = Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d(1, 1, 0).normalized())
+                          .toRotationMatrix();
+  double min_z = 1e9;
+  for (const auto& v : object.vertices) min_z = std::min(min_z, (X_tilted * v).z());
+  X_tilted.translation() = Eigen::Vector3d(0.1, 0.1, -min_z);
+  Eigen::Isometry3d X_flat = Eigen::Isometry3d::Identity();
+  X_flat.translation() = Eigen::Vector3d(-0.2, 0.0, 0.0);
+  PlanResult r;
+  r.candidates = {handMade(X_tilted, 0.9), handMade(X_flat, 0.8)};
+  const VerifyStats s =
+      verifyTopK(object, scenes::table(), cubePlanConfig(), r, 5, 0.0, 2, {}, Engines::kBoth);
+  EXPECT_EQ(s.checked, 2);
+  EXPECT_EQ(s.stayed, 1);
+  EXPECT_EQ(s.bullet_stayed, 1);
+  EXPECT_EQ(s.mujoco_stayed, 1);
+  ASSERT_EQ(r.candidates.size(), 2u);
+  const PhysicsCheck& flat = r.candidates[0].physics;
+  const PhysicsCheck& fell = r.candidates[1].physics;
+  EXPECT_EQ(fell.planner_rank, 0);
+  EXPECT_TRUE(flat.bullet_checked && flat.bullet_stayed && flat.mujoco_checked && flat.mujoco_stayed && flat.stayed);
+  EXPECT_TRUE(fell.bullet_checked && fell.mujoco_checked);
+  EXPECT_FALSE(fell.bullet_stayed);
+  EXPECT_FALSE(fell.mujoco_stayed);
+  EXPECT_FALSE(fell.stayed);
+  EXPECT_GT(fell.mujoco_turned_deg, 5.0) << "MuJoCo: moved " << fell.mujoco_moved_m << " m";
+  // MuJoCo alone: its numbers stand in moved_m / turned_deg, Bullet is not asked.
+  PlanResult m;
+  m.candidates = {handMade(X_flat, 0.8)};
+  verifyTopK(object, scenes::table(), cubePlanConfig(), m, 1, 0.0, 1, {}, Engines::kMujoco);
+  EXPECT_FALSE(m.candidates[0].physics.bullet_checked);
+  EXPECT_TRUE(m.candidates[0].physics.mujoco_stayed && m.candidates[0].physics.stayed);
+  EXPECT_EQ(m.candidates[0].physics.moved_m, m.candidates[0].physics.mujoco_moved_m);
+  EXPECT_EQ(enginesFromString("both"), Engines::kBoth);
+  EXPECT_THROW(enginesFromString("ode"), std::invalid_argument);
+}
+
 TEST(VerifyTopK, KLargerThanTheCandidatesChecksEveryStableOne) {
   PlannerConfig c = cubePlanConfig();
   c.max_candidates = 4;

@@ -22,6 +22,9 @@ struct NodeConfig {
   // Bullet check of the best K stable candidates after each plan (validation::verifyTopK), within
   // what is left of the time budget; a goal's verify_top_k overrides it. 0 = off.
   int verify_top_k = 0;
+  // Which engines check them (validation::Engines): "bullet", "mujoco" or "both" (a candidate's
+  // physics_stayed then needs both).
+  std::string verify_engines = "bullet";
   // The gripper (doc/manipulation.md), loaded once at startup into planner.gripper when
   // gripper_links is set: the URDF from ~urdf_file when set, else the parameter named
   // robot_description_param (searched up from the private namespace, as ROS tools do).

@@ -24,6 +24,7 @@
 #include <Eigen/Geometry>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "place_planner/model/mesh.h"
@@ -164,10 +165,18 @@ class PhysicsValidator {
 };
 
 // What verifyTopK did (timings are wall times of this call).
+// The engines verifyTopK asks: Bullet (the default), MuJoCo (mujoco_validator.h), or both (a
+// pose stays only when both keep it: the project's two-engine check, in the product).
+enum class Engines { kBullet, kMujoco, kBoth };
+Engines enginesFromString(const std::string& s);  // "bullet", "mujoco", "both"; else invalid_argument
+const char* toString(Engines e);
+
 struct VerifyStats {
   int selected = 0;        // stable candidates among the best K (the ones it would check)
   int checked = 0;         // ... simulated before the budget ran out
-  int stayed = 0;          // ... that stayed put
+  int stayed = 0;          // ... that stayed put (in every engine asked)
+  int bullet_stayed = 0;   // ... in Bullet, when it was asked
+  int mujoco_stayed = 0;   // ... in MuJoCo, when it was asked
   int demoted = 0;         // checked, did not stay, moved behind the other stable candidates
   double shape_ms = 0.0;   // building the Bullet shapes (once per call)
   double total_ms = 0.0;   // the whole call: shapes + simulations
@@ -190,9 +199,11 @@ struct VerifyStats {
 // but is moved behind every other stable candidate (still ahead of the unstable ones); all
 // others keep their order. k <= 0 or no stable candidate: nothing is simulated, nothing moves.
 // Throws std::invalid_argument for an empty mesh (from PhysicsValidator).
+// engines: which engines check each candidate (MuJoCo's model is compiled once per call, and a
+// MuJoCo check is not interrupted by the budget once started: about a second or two each).
 VerifyStats verifyTopK(const Mesh& object_O, const Mesh& area_W, const PlannerConfig& cfg,
                        PlanResult& result, int k, double budget_ms, int threads,
-                       const std::function<bool()>& keep_going = {});
+                       const std::function<bool()>& keep_going = {}, Engines engines = Engines::kBullet);
 
 // The budget verifyTopK gets from a plan's config and its planning time: 0 (no limit) when the
 // plan had none, else what is left, at least a tiny positive amount (a spent budget checks

@@ -113,13 +113,16 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   d.cfg = config;
   d.c_O = object_O.properties.center_of_mass;
 
-  // Pieces without margins (MuJoCo has none to make up for); the object's no larger than its
-  // narrowest loop (a hull must not bridge a handle's opening, as for Bullet).
+  // Pieces without margins (MuJoCo has none to make up for); the object's no larger than half
+  // its narrowest loop's radius: a hull must not bridge a handle's opening (as for Bullet), and
+  // a piece as long as the radius still bulges into it (a key ring of 7 mm wire bent to 2.2 cm
+  // started 1.1 cm inside the rail it hung on, and MuJoCo threw it off; at half, no contact:
+  // held-out hanging racks in both engines 6 -> 11 of 25, doc/validation.md).
   ValidatorConfig pc = config;
   pc.margin = 0.0;
   pc.piece_max_triangles = 1000;  // pieces bounded by their size (a fine mesh's too)
   pc.piece_max_size = std::min(config.piece_max_size, piece_size);
-  for (const Loop& l : findLoops(object_O)) pc.piece_max_size = std::min(pc.piece_max_size, l.radius);
+  for (const Loop& l : findLoops(object_O)) pc.piece_max_size = std::min(pc.piece_max_size, 0.5 * l.radius);
   // The area's slabs: its surface with 2 cm under it (less in thin walls), pieces twice as large
   // as the object's. A slab's contact normal stays true while it is about as thick as it is
   // long (subdivided() above): at 1 cm under 4 cm pieces a YCB bowl resting on the true table

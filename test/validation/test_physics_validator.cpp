@@ -374,17 +374,23 @@ TEST(VerifyTopK, CubeOnTableTopCandidatesStayAndTheRestAreUnchecked) {
   }
 }
 
+// The object tilted 30 degrees about a horizontal diagonal, its lowest corner on the table
+// (z = 0) at (0.1, 0.1).
+Eigen::Isometry3d onACorner(const Mesh& object) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  double min_z = 1e9;
+  for (const auto& v : object.vertices) min_z = std::min(min_z, (X * v).z());
+  X.translation() = Eigen::Vector3d(0.1, 0.1, -min_z);
+  return X;
+}
+
 // A cube balanced on a corner, tilted 30 degrees, injected as the best "stable" candidate ahead
 // of a cube flat on the table: Bullet sees it fall (turns far more than 5 degrees); it moves
 // behind the flat one, still ahead of an unstable candidate, which is not simulated.
 TEST(VerifyTopK, CubeTiltedOnACornerFallsAndMovesDownTheRanking) {
   const Mesh object = cube();
-  Eigen::Isometry3d X_tilted = Eigen::Isometry3d::Identity();
-  X_tilted.linear() = Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d(1, 1, 0).normalized())
-                          .toRotationMatrix();
-  double min_z = 1e9;
-  for (const auto& v : object.vertices) min_z = std::min(min_z, (X_tilted * v).z());
-  X_tilted.translation() = Eigen::Vector3d(0.1, 0.1, -min_z);  // lowest corner on the table
+  const Eigen::Isometry3d X_tilted = onACorner(object);
   Eigen::Isometry3d X_flat = Eigen::Isometry3d::Identity();
   X_flat.translation() = Eigen::Vector3d(-0.2, 0.0, 0.0);
   Candidate unstable = handMade(X_flat, 0.2);
@@ -420,12 +426,7 @@ TEST(VerifyTopK, CubeTiltedOnACornerFallsAndMovesDownTheRanking) {
 // kept, the cube on its corner falls in both, the flat one stays in both, and stayed is both.
 TEST(VerifyTopK, BothEnginesGiveTheirOwnVerdictsAndStayedNeedsBoth) {
   const Mesh object = cube();
-  Eigen::Isometry3d X_tilted = Eigen::Isometry3d::Identity();
-  X_tilted.linear() = Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d(1, 1, 0).normalized())
-                          .toRotationMatrix();
-  double min_z = 1e9;
-  for (const auto& v : object.vertices) min_z = std::min(min_z, (X_tilted * v).z());
-  X_tilted.translation() = Eigen::Vector3d(0.1, 0.1, -min_z);
+  const Eigen::Isometry3d X_tilted = onACorner(object);
   Eigen::Isometry3d X_flat = Eigen::Isometry3d::Identity();
   X_flat.translation() = Eigen::Vector3d(-0.2, 0.0, 0.0);
   PlanResult r;

@@ -156,6 +156,10 @@ enum class PlanOutcome {
   kCancelled,            // the progress callback said stop
 };
 const char* toString(PlanOutcome o);
+// What a search covered, for messages: "F of N floor points", "H of M threaded starts" (with
+// placement hanging the floor points are found but not searched: no start orientation), or
+// both joined by "and"; "0 of 0 floor points" when it stopped before any root was found.
+std::string searchedRoots(const PlanStats& st);
 
 struct PlanResult {
   std::vector<Candidate> candidates;  // ranked: stable first, then by quality

@@ -35,6 +35,16 @@ const char* toString(PlanOutcome o) {
   return "?";
 }
 
+std::string searchedRoots(const PlanStats& st) {
+  std::string s;
+  if (st.start_orientations > 0)
+    s = std::to_string(st.floor_points_done) + " of " + std::to_string(st.floor_points_total) + " floor points";
+  if (st.hanging_starts > 0)
+    s += (s.empty() ? "" : " and ") + std::to_string(st.hanging_starts_done) + " of " +
+         std::to_string(st.hanging_starts) + " threaded starts";
+  return s.empty() ? "0 of 0 floor points" : s;
+}
+
 int PlanResult::stableCount() const {
   int n = 0;
   for (const Candidate& c : candidates) n += c.stable;

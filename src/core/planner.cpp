@@ -159,16 +159,6 @@ RobustnessParams robustnessParams(const PlannerConfig& config, bool scanned) {
 
 // Between steps and while a setup step runs: false once the budget (`limit`, ms; 0 = none) is
 // spent or the caller cancels through the progress callback (called on the planner's thread).
-// "F of N floor points", "H of M threaded starts", or both: what a search has done so far.
-std::string searchedSoFar(const PlanStats& st, bool floor_points) {
-  std::string s;
-  if (floor_points) s = std::to_string(st.floor_points_done) + " of " + std::to_string(st.floor_points_total) + " floor points";
-  if (st.hanging_starts > 0)
-    s += (s.empty() ? "" : " and ") + std::to_string(st.hanging_starts_done) + " of " +
-         std::to_string(st.hanging_starts) + " threaded starts";
-  return s.empty() ? "0 of 0 floor points" : s;  // stopped before any root was found
-}
-
 bool keepGoing(Clock::time_point t0, double limit, const ProgressCallback& progress, Progress p,
                PlanResult& result) {
   if (limit > 0 && msSince(t0) > limit) return !(result.timed_out = true);
@@ -323,7 +313,7 @@ struct SearchMonitor {
     st.floor_points_done = std::max(0, done - hanging) / std::max(1, orientations);
     if (st.tree_nodes >= config.max_tree_nodes) {
       result.warnings.push_back("search stopped after max_tree_nodes = " + std::to_string(config.max_tree_nodes) +
-                                " poses; " + searchedSoFar(st, orientations > 0) + " done");
+                                " poses; " + searchedRoots(st) + " done");
       return false;
     }
     return keepGoing(search_budget);

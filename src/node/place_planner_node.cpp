@@ -332,13 +332,7 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   result.partial = false;
   const int n_stable = plan.stableCount();
   std::ostringstream summary;
-  summary << plan.candidates.size() << " candidates (" << n_stable << " stable) from ";
-  if (plan.stats.start_orientations > 0)
-    summary << plan.stats.floor_points_done << " of " << plan.stats.floor_points_total << " floor points";
-  if (plan.stats.hanging_starts > 0)
-    summary << (plan.stats.start_orientations > 0 ? " and " : "") << plan.stats.hanging_starts_done << " of "
-            << plan.stats.hanging_starts << " threaded starts";
-  if (plan.stats.start_orientations == 0 && plan.stats.hanging_starts == 0) summary << "0 of 0 floor points";
+  summary << plan.candidates.size() << " candidates (" << n_stable << " stable) from " << searchedRoots(plan.stats);
   summary << " in " << (ros::WallTime::now() - plan_start_).toSec() << " s"
           << physics_summary;
   if (prepared.config.has_grasp) {

@@ -358,18 +358,6 @@ void printTable(const PlanResult& r) {
   }
 }
 
-// What the search covered: "F of N floor points", "H of M threaded starts" (placement hanging:
-// the floor points are not searched), or both.
-std::string searched(const PlanStats& st) {
-  std::string s;
-  if (st.start_orientations > 0)
-    s = std::to_string(st.floor_points_done) + " of " + std::to_string(st.floor_points_total) + " floor points";
-  if (st.hanging_starts > 0)
-    s += (s.empty() ? "" : " and ") + std::to_string(st.hanging_starts_done) + " of " +
-         std::to_string(st.hanging_starts) + " threaded starts";
-  return s.empty() ? "0 of 0 floor points" : s;  // stopped before any root was found
-}
-
 // The answer in one line, always last on stdout (scripts read it with tail -1).
 void printOutcome(const PlannerConfig& c, const PlanResult& r) {
   const auto& st = r.stats;
@@ -381,17 +369,17 @@ void printOutcome(const PlannerConfig& c, const PlanResult& r) {
       break;
     case PlanOutcome::kTimedOutWithStable:
       std::printf("partial answer: the time budget of %.1f ms ran out after %s\n", c.time_budget_ms,
-                  searched(st).c_str());
+                  searchedRoots(st).c_str());
       std::printf("outcome: timed_out_partial (%d stable candidate%s so far)\n", n_stable,
                   n_stable == 1 ? "" : "s");
       break;
     case PlanOutcome::kNoStable:
       std::printf("outcome: no_stable_pose (%zu candidates, none stable, %s searched)\n", r.candidates.size(),
-                  searched(st).c_str());
+                  searchedRoots(st).c_str());
       break;
     case PlanOutcome::kTimedOutNone:
     case PlanOutcome::kCancelled:
-      std::printf("outcome: %s (nothing stable in %s within %.1f ms)\n", toString(outcome), searched(st).c_str(),
+      std::printf("outcome: %s (nothing stable in %s within %.1f ms)\n", toString(outcome), searchedRoots(st).c_str(),
                   c.time_budget_ms);
       break;
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "place_planner/manipulation/gripper.h"
+#include "place_planner/validation/physics_validator.h"
 
 #include <XmlRpcValue.h>
 
@@ -210,8 +211,11 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   if (c.verify_top_k < 0 || c.verify_top_k > 100) {
     r.fail("verify_top_k", "is out of range (0 .. 100, 0 = off)");
   }
-  if (c.verify_engines != "bullet" && c.verify_engines != "mujoco" && c.verify_engines != "both")
+  try {
+    validation::enginesFromString(c.verify_engines);
+  } catch (const std::invalid_argument&) {
     r.fail("verify_engines", "'" + c.verify_engines + "' is none of bullet, mujoco, both");
+  }
 
   // PlannerConfig, field for field (include/place_planner/config.h).
   PlannerConfig& p = c.planner;

@@ -162,6 +162,63 @@ double rayDepth(const Mesh& m, const Eigen::Vector3d& p, const Eigen::Vector3d& 
   return best;
 }
 
+// The convex hull of 2-D points, counter-clockwise (Andrew's monotone chain).
+std::vector<Eigen::Vector2d> convexHull2d(std::vector<Eigen::Vector2d> p) {
+  std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (p.size() < 3) return p;
+  auto turn = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<Eigen::Vector2d> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && turn(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && turn(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  h.resize(k > 0 ? k - 1 : 0);  // the last point repeats the first
+  return h;
+}
+
+double polygonArea(const std::vector<Eigen::Vector2d>& h) {
+  double a = 0;
+  for (size_t i = 0; i < h.size(); ++i) {
+    const Eigen::Vector2d& p = h[i];
+    const Eigen::Vector2d& q = h[(i + 1) % h.size()];
+    a += p.x() * q.y() - q.x() * p.y();
+  }
+  return 0.5 * std::abs(a);
+}
+
+// The least width of a convex polygon: across one of its edges (rotating calipers' rule).
+double polygonWidth(const std::vector<Eigen::Vector2d>& h) {
+  if (h.size() < 3) return 0.0;
+  double w = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < h.size(); ++i) {
+    const Eigen::Vector2d e = h[(i + 1) % h.size()] - h[i];
+    if (e.norm() < 1e-15) continue;
+    const Eigen::Vector2d n(-e.y() / e.norm(), e.x() / e.norm());
+    double far = 0;
+    for (const auto& p : h) far = std::max(far, std::abs(n.dot(p - h[i])));
+    w = std::min(w, far);
+  }
+  return w;
+}
+
+// A group's vertices seen along n (in-plane coordinates).
+std::vector<Eigen::Vector2d> projected(const Mesh& m, const std::vector<int>& group, const Eigen::Vector3d& n) {
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  std::vector<Eigen::Vector2d> q;
+  for (int t : group)
+    for (int k = 0; k < 3; ++k) q.emplace_back(m.vertices[m.triangles[t][k]].dot(u), m.vertices[m.triangles[t][k]].dot(v));
+  return q;
+}
+
 // btConvexHullComputer shrinks a hull by at most this share of its inner radius.
 constexpr double kShrinkClamp = 0.45;
 
@@ -189,10 +246,9 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
   TriangleGrid grid(m, reach);
 
   const double cos_max = std::cos(c.piece_max_normal_deg * M_PI / 180.0);
-  std::vector<char> used(nt, 0);
-  std::vector<std::vector<Eigen::Vector3d>> pieces;
-  for (int seed = 0; seed < nt; ++seed) {
-    if (used[seed] || area[seed] <= 0) continue;
+  // used: 0 free, 1 in a piece; a group cut again frees its triangles to `allowed` only.
+  std::vector<char> used(nt, 0), allowed(nt, 1);
+  auto grow = [&](int seed, double max_size) {
     std::vector<int> group{seed};
     used[seed] = 1;
     std::queue<int> q;
@@ -201,32 +257,74 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
       const int t = q.front();
       q.pop();
       for (int u : nbr[t]) {
-        if (used[u] || area[u] <= 0) continue;
+        if (used[u] || !allowed[u] || area[u] <= 0) continue;
         if (normal[u].dot(normal[seed]) < cos_max) continue;
-        if ((centroid[u] - centroid[seed]).norm() > c.piece_max_size) continue;
+        if ((centroid[u] - centroid[seed]).norm() > max_size) continue;
         used[u] = 1;
         group.push_back(u);
         q.push(u);
         if (static_cast<int>(group.size()) >= c.piece_max_triangles) break;
       }
     }
+    return group;
+  };
+  auto pieceNormal = [&](const std::vector<int>& group) {
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
     for (int t : group) n += area[t] * normal[t];
-    n = n.norm() > 1e-12 ? Eigen::Vector3d(n.normalized()) : normal[seed];
+    return n.norm() > 1e-12 ? Eigen::Vector3d(n.normalized()) : normal[group[0]];
+  };
+  // The share of the group's convex outline (along its normal) that its triangles cover.
+  auto fill = [&](const std::vector<int>& group) {
+    const Eigen::Vector3d n = pieceNormal(group);
+    double covered = 0;
+    for (int t : group) covered += area[t] * std::abs(normal[t].dot(n));
+    const double outline = polygonArea(convexHull2d(projected(m, group, n)));
+    return outline > 1e-12 ? covered / outline : 1.0;
+  };
+  std::vector<std::vector<int>> groups;
+  for (int seed = 0; seed < nt; ++seed) {
+    if (used[seed] || area[seed] <= 0) continue;
+    std::vector<std::pair<std::vector<int>, double>> todo;  // a group, the size it was grown to
+    todo.emplace_back(grow(seed, c.piece_max_size), c.piece_max_size);
+    while (!todo.empty()) {
+      auto [g, size] = std::move(todo.back());
+      todo.pop_back();
+      if (c.piece_min_fill <= 0 || g.size() < 2 || fill(g) >= c.piece_min_fill) {
+        groups.push_back(std::move(g));
+        continue;
+      }
+      // Cut again, half as large, within the group's triangles.
+      std::fill(allowed.begin(), allowed.end(), 0);
+      for (int t : g) allowed[t] = 1, used[t] = 0;
+      for (int t : g)
+        if (!used[t]) todo.emplace_back(grow(t, 0.5 * size), 0.5 * size);
+      std::fill(allowed.begin(), allowed.end(), 1);
+    }
+  }
+  std::vector<std::vector<Eigen::Vector3d>> pieces;
+  for (const std::vector<int>& group : groups) {
+    const Eigen::Vector3d n = pieceNormal(group);
     // Thickness: piece_thickness, less where the opposite surface is closer (thin walls, the
     // marker's 2 cm body) so that the piece does not poke out on the other side; a piece facing
     // along piece_full_depth_along keeps it all (no depth rays cast).
     const bool full = c.piece_full_depth_along.norm() > 0 &&
                       n.dot(c.piece_full_depth_along.normalized()) > std::cos(M_PI / 4);
     double depth = std::numeric_limits<double>::infinity();
-    if (!full)
+    // A full-depth piece's thickness need be no more than its width (a slab about as thick as
+    // it is wide keeps its contact normal true, mujoco_validator.cpp): a floor's 4 cm piece
+    // keeps 2 cm, a wire's 7 mm top strip is a slab to the wire's underside, not 2 cm below it
+    // where a handle hung on the wire passes.
+    double width = std::numeric_limits<double>::infinity();
+    if (full) width = polygonWidth(convexHull2d(projected(m, group, n)));
+    if (!full || width < c.piece_thickness)
       for (int t : group)
         for (int k = 0; k < 3; ++k) {
           const Eigen::Vector3d& p = m.vertices[m.triangles[t][k]];
           const Eigen::Vector3d start = p - 1e-6 * n;
           depth = std::min(depth, rayDepth(m, start, -n, grid.near(start, start - reach * n), group));
         }
-    const double thickness = std::min(depth, c.piece_thickness);
+    const double thickness = full && width < c.piece_thickness ? std::min(std::max(depth, width), c.piece_thickness)
+                                                                : std::min(depth, c.piece_thickness);
     // The hull is shrunk by both margins (object's and area's) below, but Bullet shrinks a hull
     // by at most kShrinkClamp of its inner radius (about half a slab's thickness): a thin slab
     // keeps most of the margins, and a mug's 1.5 mm bottom rested 5-7 mm above the table (with

@@ -499,6 +499,36 @@ TEST(Penetration, AThickPostThroughALongFaceIsSeenByTheProbes) {
   EXPECT_EQ(penetrationDepth(om, am, toRigid(X)), 0.0);
 }
 
+// A box 4 mm into a wall and 1.5 mm into the floor in front of it (the corner of a wall and a
+// floor): the clearing shift takes it out of both, to within the clearance, by about as much
+// as it was in, and leaves a box already clear where it is.
+TEST(Penetration, TheClearingShiftTakesABoxOutOfAWallAndAFloor) {
+  const Mesh corner = scenes::merge({scenes::box(0.4, 0.4, 0.02, {0, 0, -0.01}), scenes::box(0.02, 0.4, 0.3, {0.01, 0, 0.15})},
+                                    "corner");
+  const AreaModel am = buildAreaModel(corner, {0, 0, -1}, 0.002, 0.0035, 0.0035);
+  ObjectModel om = buildObjectModel(scenes::box(0.06, 0.06, 0.06), 0.002);
+  addProbes(om, 0.008);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(-0.03 + 0.004, 0, 0.03 - 0.0015);  // +x face 4 mm in the wall
+  ASSERT_NEAR(penetrationDepth(om, am, toRigid(X)), 0.004, 5e-4);
+  const double clearance = 0.001;
+  const std::optional<V3> shift = clearingShift(om, am, toRigid(X), clearance, 0.01);
+  ASSERT_TRUE(shift) << "not clearable";
+  const V3 s = *shift;
+  EXPECT_NEAR(s.x, -0.0035, 5e-4) << "out of the wall along its normal, to the clearance's middle";
+  EXPECT_GT(s.z, 0.0) << "out of the floor";
+  EXPECT_LT(s.z, 0.0015);
+  X.translation() += toEigen(s);
+  EXPECT_LE(penetrationDepth(om, am, toRigid(X)), clearance);
+  // Clear already: no shift.
+  const std::optional<V3> none = clearingShift(om, am, toRigid(X), clearance, 0.01);
+  ASSERT_TRUE(none);
+  EXPECT_EQ(norm(*none), 0.0);
+  // Deeper than the largest shift allowed: not clearable.
+  X.translation().x() += 0.008;
+  EXPECT_FALSE(clearingShift(om, am, toRigid(X), clearance, 0.004));
+}
+
 TEST(Ranking, TheLargerTippingMarginRanksFirstAmongEqualPoses) {
   // Two stable poses of a 10 cm cube on a flat top, alike in Q, contacts and robust share; one
   // tips off after 2 degrees of tilt, the other after 8. The tie-break alone (nearer the frame's

@@ -10,6 +10,7 @@
 #include "place_planner/infra/scenes.h"
 #include "place_planner/planner.h"
 #include "place_planner/validation/mesh_variants.h"
+#include "place_planner/validation/mujoco_validator.h"
 #include "place_planner/validation/physics_validator.h"
 #include "validation_test_helpers.h"
 
@@ -152,6 +153,12 @@ void expectStillHangsInBullet(const Mesh& object, const Mesh& area, const Candid
   const PoseCheck p = PhysicsValidator(object, area, damped()).check(best.X_WO);
   EXPECT_TRUE(stillHanging(p, best.X_WO, object.properties.center_of_mass, damped()))
       << "Bullet: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
+}
+
+void expectStillHangsInMujoco(const Mesh& object, const Mesh& area, const Candidate& best) {
+  const PoseCheck p = MujocoValidator(object, area, damped()).check(best.X_WO);
+  EXPECT_TRUE(stillHanging(p, best.X_WO, object.properties.center_of_mass, damped()))
+      << "MuJoCo: moved " << 1000 * p.moved_m << " mm, turned " << p.turned_deg << " deg";
 }
 
 // A wall mug rack whose board is only 12 cm tall, its pegs rising 15 degrees: the mug slides
@@ -310,6 +317,7 @@ TEST(Hanging, YcbMugTurnsItsBodyOutFromTheWallToPassAShortJHooksTip) {
     on_arm += p.p_W.z() > com.z() + 0.01 && p.p_W.y() < 0 && p.p_W.y() > -0.05 && p.p_W.z() < 0.415;
   EXPECT_GT(on_arm, 0) << "it does not hang from a hook's arm";
   expectStillHangsInBullet(mug, hooks, *best);
+  expectStillHangsInMujoco(mug, hooks, *best);
 }
 
 // A pan 20 cm across with a slot 2 cm wide and 4 cm long through its handle's end, on two J-hooks

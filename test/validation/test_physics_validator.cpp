@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "place_planner/infra/mesh_io.h"
@@ -517,6 +518,78 @@ TEST(VerifyTopK, RemainingBudget) {
   const double spent = remainingBudgetMs(100.0, 150.0);
   EXPECT_GT(spent, 0.0) << "a spent budget must not read as no limit";
   EXPECT_LT(spent, 1e-3);
+}
+
+// A flat L, 8 mm thick (y), as a J-hook's flank: an arm 6 cm along x and a tip 4 cm up (z),
+// 1 cm wide, one planar face each side. In one piece, its hull fills the corner between arm
+// and tip, where a handle hung on the arm passes (MuJoCo threw the YCB mug off a J-hook from
+// there); with piece_min_fill no piece reaches into the corner.
+Mesh flatL() {
+  const double a = 0.06, h = 0.04, t = 0.01, w = 0.008;
+  const std::vector<Eigen::Vector2d> o{{0, 0}, {a, 0}, {a, t}, {t, t}, {t, h}, {0, h}};  // x, z
+  std::vector<Eigen::Vector3d> v;
+  for (const double y : {0.0, w})
+    for (const auto& p : o) v.emplace_back(p.x(), y, p.y());
+  std::vector<std::vector<int>> f;
+  for (int k = 1; k + 1 < 6; ++k) f.push_back({0, k, k + 1}), f.push_back({6, 6 + k + 1, 6 + k});  // outward
+  for (int k = 0; k < 6; ++k) f.push_back({k, 6 + k, 6 + (k + 1) % 6, (k + 1) % 6});
+  return buildMesh(v, f, "flat L");
+}
+
+// Whether (x, z) lies inside the convex outline of the points seen along y (monotone chain).
+bool insideOutlineXZ(const std::vector<Eigen::Vector3d>& pts, double x, double z) {
+  std::vector<Eigen::Vector2d> p;
+  for (const auto& q : pts) p.emplace_back(q.x(), q.z());
+  std::sort(p.begin(), p.end(), [](const auto& a, const auto& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  auto turn = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::vector<Eigen::Vector2d> h;
+  for (int pass = 0; pass < 2; ++pass) {
+    const size_t start = h.size();
+    for (const auto& q : p) {
+      while (h.size() >= start + 2 && turn(h[h.size() - 2], h.back(), q) <= 0) h.pop_back();
+      h.push_back(q);
+    }
+    h.pop_back();
+    std::reverse(p.begin(), p.end());
+  }
+  if (h.size() < 3) return false;
+  for (size_t i = 0; i < h.size(); ++i)
+    if (turn(h[i], h[(i + 1) % h.size()], Eigen::Vector2d(x, z)) <= 0) return false;
+  return true;
+}
+
+TEST(ConvexPieces, ACutAgainPieceDoesNotFillTheCornerOfAFlatL) {
+  const Mesh L = flatL();
+  ValidatorConfig c;
+  c.piece_max_triangles = 1000;
+  c.piece_max_size = 0.2;  // the whole face in one group
+  auto reachesCorner = [&](double min_fill) {
+    c.piece_min_fill = min_fill;
+    int n = 0;
+    for (const auto& piece : convexPieces(L, c)) n += insideOutlineXZ(piece, 0.03, 0.02);
+    return n;
+  };
+  EXPECT_GT(reachesCorner(0.0), 0) << "the test would pass on nothing: one piece per face does not fill the corner";
+  EXPECT_EQ(reachesCorner(0.8), 0);
+}
+
+// A horizontal bar 8 mm thick under MuJoCo's floor rule (piece_full_depth_along up): its top's
+// slab reaches to the bar's underside, not 2 cm below it, where a handle hung on the bar passes.
+// A floor piece as wide as the slab is thick keeps the 2 cm (a true contact normal).
+TEST(ConvexPieces, AThinBarsTopSlabEndsAtItsUnderside) {
+  ValidatorConfig c;
+  c.piece_thickness = 0.02;
+  c.piece_full_depth_along = Eigen::Vector3d::UnitZ();
+  auto lowest = [&](const Mesh& m) {
+    double z = 1;
+    for (const auto& piece : convexPieces(m, c))
+      for (const auto& p : piece) z = std::min(z, p.z());
+    return z;
+  };
+  EXPECT_GT(lowest(scenes::box(0.10, 0.008, 0.008, {0, 0, 0.004})), -0.001);  // the bar: 0 to 8 mm
+  EXPECT_LT(lowest(scenes::box(0.10, 0.10, 0.003, {0, 0, 0.0015})), -0.015);   // a 3 mm floor: 2 cm slabs
 }
 
 }  // namespace

@@ -61,6 +61,11 @@ struct ValidatorConfig {
   // slab may reach below a thin floor, where nothing rests, and must be thick to give a true
   // contact normal.
   Eigen::Vector3d piece_full_depth_along = Eigen::Vector3d::Zero();
+  // A piece whose triangles cover less than this share of their convex outline (seen along the
+  // piece's normal) is cut again, half as large, until they do (0: off). MuJoCo's pieces
+  // (mujoco_validator.h): the flat flank of a J-hook, arm and turned-up tip in one plane, made
+  // one L-shaped piece whose hull filled the corner where a handle hangs.
+  double piece_min_fill = 0.0;
   // An object with a loop (search/loops.h: a handle's opening, a ring's hole) is cut into pieces
   // no larger than its narrowest loop's radius, so that no piece's hull bridges the opening.
   // Measured: the YCB mug hung by its handle on a peg, with 5 cm pieces, was pushed off the peg

@@ -7,8 +7,12 @@
 
 namespace place_planner {
 
-Penetration penetration(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
-                        double max_depth, bool dense) {
+namespace {
+
+// Each probe's depth (kInf: outside) and the normal of the surface it is deepest in; the
+// deepest below a surface straight above in *up.
+void probeDepths(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO, double max_depth, bool dense,
+                 std::vector<double>& depth, std::vector<V3>& normal, double* up_out) {
   dense = dense && !object.probes.empty();  // none added: the vertices
   const std::vector<V3>& probes = dense ? object.probes : object.vertices;
   const BvhView obj = view(dense ? object.probe_bvh : object.vertex_bvh), tris = view(area.triangle_bvh);
@@ -19,9 +23,10 @@ Penetration penetration(const ObjectModel& object, const AreaModel& area, const 
   // Each vertex's nearest area triangle along each ray, within max_depth. One walk over the
   // object's vertex tree (posed, swept by max_depth) and the area's triangle tree
   // (dualTraverse) per ray instead of one ray from the root per vertex: about 3x faster.
-  thread_local std::vector<double> nearest, depth;
+  thread_local std::vector<double> nearest;
   thread_local std::vector<int> hit;
   depth.assign(probes.size(), kInf);
+  normal.assign(probes.size(), v3(0, 0, 1));
   double up = 0;  // the deepest below a surface straight above
   for (int k = 0; k < 5; ++k) {
     const V3 dir = dirs[k];
@@ -48,14 +53,47 @@ Penetration penetration(const ObjectModel& object, const AreaModel& area, const 
       const V3& n = area.triangle_normals[hit[vi]];
       const double along = dot(n, dir) / std::max(1e-12, norm(n));
       if (k == 0 && along > 0) up = std::max(up, nearest[vi] * along);
-      if (along > 0) depth[vi] = std::min(depth[vi], nearest[vi] * along);
+      if (along > 0 && nearest[vi] * along < depth[vi]) {
+        depth[vi] = nearest[vi] * along;
+        normal[vi] = normalized(n);
+      }
     }
   }
+  *up_out = up;
+}
+
+}  // namespace
+
+Penetration penetration(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
+                        double max_depth, bool dense) {
+  thread_local std::vector<double> depth;
+  thread_local std::vector<V3> normal;
   Penetration deepest;
-  deepest.below = up;
+  probeDepths(object, area, X_GO, max_depth, dense, depth, normal, &deepest.below);
   for (const double d : depth)
     if (d < kInf) deepest.depth = std::max(deepest.depth, d);
   return deepest;
+}
+
+std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO, double clearance,
+                 double max_shift, int max_steps) {
+  thread_local std::vector<double> depth;
+  thread_local std::vector<V3> normal;
+  V3 shift = v3(0, 0, 0);
+  for (int step = 0; step < max_steps; ++step) {
+    Rigid X = X_GO;
+    X.t = X.t + shift;
+    double up = 0;
+    probeDepths(object, area, X, 0.03, true, depth, normal, &up);
+    size_t deepest = depth.size();
+    for (size_t i = 0; i < depth.size(); ++i)
+      if (depth[i] < kInf && depth[i] > clearance && (deepest == depth.size() || depth[i] > depth[deepest])) deepest = i;
+    if (deepest == depth.size()) return shift;  // clear
+    // Out of the deepest probe's surface along its normal, to the clearance's middle.
+    shift = shift + (depth[deepest] - 0.5 * clearance) * normal[deepest];
+    if (norm(shift) > max_shift) break;
+  }
+  return std::nullopt;
 }
 
 double penetrationDepth(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,

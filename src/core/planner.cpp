@@ -125,8 +125,8 @@ std::vector<V3> findFloorPoints(const AreaModel& am, const PlannerConfig& config
 // object along gravity only, so against a wall it settles within that band of the wall, not
 // on it (penetration.h; measured on the hanging suites, doc/method.md).
 constexpr double kSidewaysPenetration = 2.5;
-// m: a returned hanging pose lies no deeper in the area than this (clearOfTheArea).
-constexpr double kResultClearance = 0.001;
+// m: a returned hanging pose is moved out of the area and this far beyond (clearOfTheArea).
+constexpr double kResultClearance = 0.0005;
 
 // What the tree steps need (Sections V, VI): models, backend, stability parameters.
 TreeContext treeContext(const Mesh& object, const ObjectModel& om, const AreaModel& am, Backend& backend,
@@ -646,12 +646,12 @@ class TreeSearch {
   SearchMonitor monitor_;
 };
 
-// A returned hanging pose moved out of the area to within kResultClearance (penetration.h,
+// A returned hanging pose moved out of the area, kResultClearance beyond it (penetration.h,
 // clearingShift), with its path and pre-place pose (its contacts stay where it touches, where
-// it swings back to when let go, by the millimetres moved): the guard lets it lie up to a
-// contact distance inside a wall it swung against, where a robot's release collides (MuJoCo
-// threw such a mug off a J-hook; doc/method.md, "The returned pose is clear of the area").
-// Where more than 3 sphere radii would be needed it stays where the search found it.
+// it swings back to when let go): the guard lets it lie up to a contact distance inside a wall
+// it swung against, where a robot's release collides (MuJoCo threw such a mug off a J-hook;
+// doc/method.md, "The returned pose is clear of the area"). One that no move of at most 3
+// sphere radii clears is jammed (out of one surface is into another): not stable.
 void clearOfTheArea(const Models& m, const PlannerConfig& config, std::vector<Candidate>& candidates) {
   const Eigen::Matrix3d R_GW = m.am->R_GW;
   for (Candidate& c : candidates) {
@@ -659,14 +659,18 @@ void clearOfTheArea(const Models& m, const PlannerConfig& config, std::vector<Ca
     Eigen::Isometry3d X_GO = Eigen::Isometry3d::Identity();
     X_GO.linear() = R_GW * c.X_WO.linear();
     X_GO.translation() = R_GW * c.X_WO.translation();
-    const std::optional<V3> s = clearingShift(m.om, *m.am, toRigid(X_GO), kResultClearance, 3.0 * m.rad.r + kResultClearance);
-    if (!s) continue;
+    const std::optional<V3> s = clearingShift(m.om, *m.am, toRigid(X_GO), kResultClearance, 3.0 * m.rad.r + 2 * kResultClearance);
+    if (!s) {
+      c.stable = false;
+      continue;
+    }
     const Eigen::Vector3d shift = R_GW.transpose() * toEigen(*s);
     c.X_WO.pretranslate(shift);
     for (Eigen::Isometry3d& X : c.intermediate_poses) X.pretranslate(shift);
     c.placement.pre_place_W.pretranslate(shift);
     if (c.has_gripper_pose) c.X_WF = c.X_WO * config.grasp;
   }
+  std::stable_partition(candidates.begin(), candidates.end(), [](const Candidate& c) { return c.stable; });
 }
 
 }  // namespace

@@ -500,8 +500,8 @@ TEST(Penetration, AThickPostThroughALongFaceIsSeenByTheProbes) {
 }
 
 // A box 4 mm into a wall and 1.5 mm into the floor in front of it (the corner of a wall and a
-// floor): the clearing shift takes it out of both, to within the clearance, by about as much
-// as it was in, and leaves a box already clear where it is.
+// floor): the clearing shift takes it out of both, `gap` beyond each, and leaves a box already
+// clear where it is. Jammed between two walls closer than it is wide, no shift clears it.
 TEST(Penetration, TheClearingShiftTakesABoxOutOfAWallAndAFloor) {
   const Mesh corner = scenes::merge({scenes::box(0.4, 0.4, 0.02, {0, 0, -0.01}), scenes::box(0.02, 0.4, 0.3, {0.01, 0, 0.15})},
                                     "corner");
@@ -511,22 +511,27 @@ TEST(Penetration, TheClearingShiftTakesABoxOutOfAWallAndAFloor) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.translation() = Eigen::Vector3d(-0.03 + 0.004, 0, 0.03 - 0.0015);  // +x face 4 mm in the wall
   ASSERT_NEAR(penetrationDepth(om, am, toRigid(X)), 0.004, 5e-4);
-  const double clearance = 0.001;
-  const std::optional<V3> shift = clearingShift(om, am, toRigid(X), clearance, 0.01);
+  const double gap = 0.0005;
+  const std::optional<V3> shift = clearingShift(om, am, toRigid(X), gap, 0.01);
   ASSERT_TRUE(shift) << "not clearable";
-  const V3 s = *shift;
-  EXPECT_NEAR(s.x, -0.0035, 5e-4) << "out of the wall along its normal, to the clearance's middle";
-  EXPECT_GT(s.z, 0.0) << "out of the floor";
-  EXPECT_LT(s.z, 0.0015);
-  X.translation() += toEigen(s);
-  EXPECT_LE(penetrationDepth(om, am, toRigid(X)), clearance);
+  EXPECT_NEAR(shift->x, -0.0045, 2e-4) << "out of the wall along its normal, and the gap beyond";
+  EXPECT_NEAR(shift->z, 0.002, 2e-4) << "out of the floor, and the gap beyond";
+  X.translation() += toEigen(*shift);
+  EXPECT_LE(penetrationDepth(om, am, toRigid(X)), 1e-5);
   // Clear already: no shift.
-  const std::optional<V3> none = clearingShift(om, am, toRigid(X), clearance, 0.01);
+  const std::optional<V3> none = clearingShift(om, am, toRigid(X), gap, 0.01);
   ASSERT_TRUE(none);
   EXPECT_EQ(norm(*none), 0.0);
   // Deeper than the largest shift allowed: not clearable.
-  X.translation().x() += 0.008;
-  EXPECT_FALSE(clearingShift(om, am, toRigid(X), clearance, 0.004));
+  X.translation().x() += 0.0125;
+  EXPECT_FALSE(clearingShift(om, am, toRigid(X), gap, 0.004));
+  // Between two walls 5.5 cm apart, the 6 cm box is 2.5 mm in each: out of one is into the other.
+  const Mesh slot = scenes::merge({scenes::box(0.02, 0.4, 0.3, {-0.0375, 0, 0.15}), scenes::box(0.02, 0.4, 0.3, {0.0375, 0, 0.15})},
+                                  "slot");
+  const AreaModel walls = buildAreaModel(slot, {0, 0, -1}, 0.002, 0.0035, 0.0035);
+  X.translation() = Eigen::Vector3d(0, 0, 0.05);
+  ASSERT_NEAR(penetrationDepth(om, walls, toRigid(X)), 0.0025, 5e-4);
+  EXPECT_FALSE(clearingShift(om, walls, toRigid(X), gap, 0.01));
 }
 
 TEST(Ranking, TheLargerTippingMarginRanksFirstAmongEqualPoses) {

@@ -37,12 +37,12 @@ struct Penetration {
 Penetration penetration(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
                         double max_depth = 0.03, bool dense = true);
 
-// The translation (G) that takes the object out of the area to within `clearance` (each probe
-// at most that deep), moved out of the deepest probe's surface along its normal, again until
-// clear: a hanging pose settles within its contact band against a wall (sideways up to the
-// contact distance, the guard above), where a robot's release would collide. None when more
-// than max_steps moves or a shift over max_shift would be needed.
-std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO, double clearance,
-                 double max_shift, int max_steps = 6);
+// The translation (G) that takes the object out of the area: the deepest probe moved out of its
+// surface along that surface's normal, `gap` beyond it, again until no probe is inside. A
+// hanging pose settles within its contact band against a wall (sideways up to the contact
+// distance, the guard above), where a robot's release would collide. None when more than
+// max_steps moves or a shift over max_shift would be needed.
+std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO, double gap,
+                                double max_shift, int max_steps = 6);
 
 }  // namespace place_planner

@@ -75,8 +75,9 @@ Penetration penetration(const ObjectModel& object, const AreaModel& area, const 
   return deepest;
 }
 
-std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO, double clearance,
-                 double max_shift, int max_steps) {
+std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO, double gap,
+                                 double max_shift, int max_steps) {
+  constexpr double kInside = 1e-5;  // m: a probe this deep or less is on the surface, not in it
   thread_local std::vector<double> depth;
   thread_local std::vector<V3> normal;
   V3 shift = v3(0, 0, 0);
@@ -87,10 +88,10 @@ std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area
     probeDepths(object, area, X, 0.03, true, depth, normal, &up);
     size_t deepest = depth.size();
     for (size_t i = 0; i < depth.size(); ++i)
-      if (depth[i] < kInf && depth[i] > clearance && (deepest == depth.size() || depth[i] > depth[deepest])) deepest = i;
+      if (depth[i] < kInf && depth[i] > kInside && (deepest == depth.size() || depth[i] > depth[deepest])) deepest = i;
     if (deepest == depth.size()) return shift;  // clear
-    // Out of the deepest probe's surface along its normal, to the clearance's middle.
-    shift = shift + (depth[deepest] - 0.5 * clearance) * normal[deepest];
+    // Out of the deepest probe's surface along its normal, and `gap` beyond it.
+    shift = shift + (depth[deepest] + gap) * normal[deepest];
     if (norm(shift) > max_shift) break;
   }
   return std::nullopt;

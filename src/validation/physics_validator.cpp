@@ -4,6 +4,8 @@
 #include <LinearMath/btConvexHullComputer.h>
 #include <btBulletDynamicsCommon.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -162,49 +164,26 @@ double rayDepth(const Mesh& m, const Eigen::Vector3d& p, const Eigen::Vector3d& 
   return best;
 }
 
-// The convex hull of 2-D points, counter-clockwise (Andrew's monotone chain).
-std::vector<Eigen::Vector2d> convexHull2d(std::vector<Eigen::Vector2d> p) {
-  std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
-  if (p.size() < 3) return p;
-  auto turn = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
-  };
-  std::vector<Eigen::Vector2d> h(2 * p.size());
-  size_t k = 0;
-  for (size_t i = 0; i < p.size(); ++i) {
-    while (k >= 2 && turn(h[k - 2], h[k - 1], p[i]) <= 0) --k;
-    h[k++] = p[i];
-  }
-  for (size_t i = p.size() - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && turn(h[k - 2], h[k - 1], p[i]) <= 0) --k;
-    h[k++] = p[i];
-  }
-  h.resize(k > 0 ? k - 1 : 0);  // the last point repeats the first
-  return h;
+// The convex hull of 2-D points (OpenCV's), its area and its least width: across one of its
+// edges (the rotating calipers' rule).
+std::vector<cv::Point2f> convexHull2d(const std::vector<Eigen::Vector2d>& p) {
+  std::vector<cv::Point2f> pts, hull;
+  for (const auto& q : p) pts.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
+  if (pts.size() >= 3) cv::convexHull(pts, hull);
+  return hull;
 }
 
-double polygonArea(const std::vector<Eigen::Vector2d>& h) {
-  double a = 0;
-  for (size_t i = 0; i < h.size(); ++i) {
-    const Eigen::Vector2d& p = h[i];
-    const Eigen::Vector2d& q = h[(i + 1) % h.size()];
-    a += p.x() * q.y() - q.x() * p.y();
-  }
-  return 0.5 * std::abs(a);
-}
+double polygonArea(const std::vector<cv::Point2f>& h) { return h.size() < 3 ? 0.0 : cv::contourArea(h); }
 
-// The least width of a convex polygon: across one of its edges (rotating calipers' rule).
-double polygonWidth(const std::vector<Eigen::Vector2d>& h) {
+double polygonWidth(const std::vector<cv::Point2f>& h) {
   if (h.size() < 3) return 0.0;
   double w = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < h.size(); ++i) {
-    const Eigen::Vector2d e = h[(i + 1) % h.size()] - h[i];
-    if (e.norm() < 1e-15) continue;
-    const Eigen::Vector2d n(-e.y() / e.norm(), e.x() / e.norm());
+    const cv::Point2d a = h[i], e = cv::Point2d(h[(i + 1) % h.size()]) - a;
+    const double len = std::hypot(e.x, e.y);
+    if (len < 1e-12) continue;
     double far = 0;
-    for (const auto& p : h) far = std::max(far, std::abs(n.dot(p - h[i])));
+    for (const cv::Point2d p : h) far = std::max(far, std::abs(e.x * (p.y - a.y) - e.y * (p.x - a.x)) / len);
     w = std::min(w, far);
   }
   return w;

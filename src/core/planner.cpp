@@ -646,20 +646,20 @@ class TreeSearch {
   SearchMonitor monitor_;
 };
 
-// A returned hanging pose moved out of the area, kResultClearance beyond it (penetration.h,
+// A returned hanging pose moved out of the area, `gap` beyond it (penetration.h,
 // clearingShift), with its path and pre-place pose (its contacts stay where it touches, where
 // it swings back to when let go): the guard lets it lie up to a contact distance inside a wall
 // it swung against, where a robot's release collides (MuJoCo threw such a mug off a J-hook;
 // doc/method.md, "The returned pose is clear of the area"). One that no move of at most 3
 // sphere radii clears is jammed (out of one surface is into another): not stable.
-void clearOfTheArea(const Models& m, const PlannerConfig& config, std::vector<Candidate>& candidates) {
+void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, std::vector<Candidate>& candidates) {
   const Eigen::Matrix3d R_GW = m.am->R_GW;
   for (Candidate& c : candidates) {
     if (!c.hanging) continue;
     Eigen::Isometry3d X_GO = Eigen::Isometry3d::Identity();
     X_GO.linear() = R_GW * c.X_WO.linear();
     X_GO.translation() = R_GW * c.X_WO.translation();
-    const std::optional<V3> s = clearingShift(m.om, *m.am, toRigid(X_GO), kResultClearance, 3.0 * m.rad.r + 2 * kResultClearance);
+    const std::optional<V3> s = clearingShift(m.om, *m.am, toRigid(X_GO), gap, 3.0 * m.rad.r + 2 * gap);
     if (!s) {
       c.stable = false;
       continue;
@@ -728,7 +728,9 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   TreeSearch search(run, *models, *roots);
   search.run();
   search.rank(*roots);
-  clearOfTheArea(*models, config, run.result.candidates);
+  // A scan's true surface may lie scan_noise beyond it: a scanned object is cleared by that too.
+  clearOfTheArea(*models, config, kResultClearance + (completion.completed() ? config.scan_noise : 0.0),
+                 run.result.candidates);
   // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
   // released scan_noise higher (config.h), with its path and pre-place pose.
   if (completion.completed() && config.scan_noise > 0) {

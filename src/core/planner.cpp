@@ -653,18 +653,16 @@ class TreeSearch {
 // doc/method.md, "The returned pose is clear of the area"). One that no move of at most 3
 // sphere radii clears is jammed (out of one surface is into another): not stable.
 void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, std::vector<Candidate>& candidates) {
-  const Eigen::Matrix3d R_GW = m.am->R_GW;
+  Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
+  X_GW.linear() = m.am->R_GW;
   for (Candidate& c : candidates) {
     if (!c.hanging) continue;
-    Eigen::Isometry3d X_GO = Eigen::Isometry3d::Identity();
-    X_GO.linear() = R_GW * c.X_WO.linear();
-    X_GO.translation() = R_GW * c.X_WO.translation();
-    const std::optional<V3> s = clearingShift(m.om, *m.am, toRigid(X_GO), gap, 3.0 * m.rad.r + 2 * gap);
+    const std::optional<V3> s = clearingShift(m.om, *m.am, toRigid(X_GW * c.X_WO), gap, 3.0 * m.rad.r + 2 * gap);
     if (!s) {
       c.stable = false;
       continue;
     }
-    const Eigen::Vector3d shift = R_GW.transpose() * toEigen(*s);
+    const Eigen::Vector3d shift = m.am->R_GW.transpose() * toEigen(*s);
     c.X_WO.pretranslate(shift);
     for (Eigen::Isometry3d& X : c.intermediate_poses) X.pretranslate(shift);
     c.placement.pre_place_W.pretranslate(shift);

@@ -225,8 +225,11 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
   TriangleGrid grid(m, reach);
 
   const double cos_max = std::cos(c.piece_max_normal_deg * M_PI / 180.0);
-  // used: 0 free, 1 in a piece; a group cut again frees its triangles to `allowed` only.
-  std::vector<char> used(nt, 0), allowed(nt, 1);
+  // used: 0 free, 1 in a piece. A group cut again is stamped in `region`, and while it is cut
+  // (`active` its stamp, 0 none) only its triangles may grow.
+  std::vector<char> used(nt, 0);
+  std::vector<int> region(nt, 0);
+  int active = 0, stamp = 0;
   auto grow = [&](int seed, double max_size) {
     std::vector<int> group{seed};
     used[seed] = 1;
@@ -236,7 +239,7 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
       const int t = q.front();
       q.pop();
       for (int u : nbr[t]) {
-        if (used[u] || !allowed[u] || area[u] <= 0) continue;
+        if (used[u] || (active != 0 && region[u] != active) || area[u] <= 0) continue;
         if (normal[u].dot(normal[seed]) < cos_max) continue;
         if ((centroid[u] - centroid[seed]).norm() > max_size) continue;
         used[u] = 1;
@@ -273,11 +276,11 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
         continue;
       }
       // Cut again, half as large, within the group's triangles.
-      std::fill(allowed.begin(), allowed.end(), 0);
-      for (int t : g) allowed[t] = 1, used[t] = 0;
+      active = ++stamp;
+      for (int t : g) region[t] = active, used[t] = 0;
       for (int t : g)
         if (!used[t]) todo.emplace_back(grow(t, 0.5 * size), 0.5 * size);
-      std::fill(allowed.begin(), allowed.end(), 1);
+      active = 0;
     }
   }
   std::vector<std::vector<Eigen::Vector3d>> pieces;
@@ -302,8 +305,7 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
           const Eigen::Vector3d start = p - 1e-6 * n;
           depth = std::min(depth, rayDepth(m, start, -n, grid.near(start, start - reach * n), group));
         }
-    const double thickness = full && width < c.piece_thickness ? std::min(std::max(depth, width), c.piece_thickness)
-                                                                : std::min(depth, c.piece_thickness);
+    const double thickness = std::min(full ? std::max(depth, width) : depth, c.piece_thickness);
     // The hull is shrunk by both margins (object's and area's) below, but Bullet shrinks a hull
     // by at most kShrinkClamp of its inner radius (about half a slab's thickness): a thin slab
     // keeps most of the margins, and a mug's 1.5 mm bottom rested 5-7 mm above the table (with

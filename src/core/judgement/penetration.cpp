@@ -10,7 +10,7 @@ namespace place_planner {
 namespace {
 
 // Each probe's depth (kInf: outside) and the normal of the surface it is deepest in; the
-// deepest below a surface straight above in *up.
+// deepest below a surface straight above in *up_out where given.
 void probeDepths(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO, double max_depth, bool dense,
                  std::vector<double>& depth, std::vector<V3>& normal, double* up_out) {
   dense = dense && !object.probes.empty();  // none added: the vertices
@@ -59,7 +59,7 @@ void probeDepths(const ObjectModel& object, const AreaModel& area, const Rigid& 
       }
     }
   }
-  *up_out = up;
+  if (up_out) *up_out = up;
 }
 
 }  // namespace
@@ -84,8 +84,7 @@ std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area
   for (int step = 0; step < max_steps; ++step) {
     Rigid X = X_GO;
     X.t = X.t + shift;
-    double up = 0;
-    probeDepths(object, area, X, 0.03, true, depth, normal, &up);
+    probeDepths(object, area, X, 0.03, true, depth, normal, nullptr);
     size_t deepest = depth.size();
     for (size_t i = 0; i < depth.size(); ++i)
       if (depth[i] < kInf && depth[i] > kInside && (deepest == depth.size() || depth[i] > depth[deepest])) deepest = i;

@@ -278,7 +278,7 @@ struct SearchMonitor {
       inside[k] = !penetration(om, am, l.X_GO, 0.03, l.hanging).within(penetration_limit, penetration_sideways);
     });
     for (size_t k = 0; k < fresh.size(); ++k)
-      if (inside[k]) all[fresh[k]].stable = false;
+      if (inside[k]) all[fresh[k]].stable = false, all[fresh[k]].inside = true;
     fresh.erase(std::remove_if(fresh.begin(), fresh.end(), [&](size_t i) { return !all[i].stable; }), fresh.end());
     // Until a robust stable pose is found, the new stable leaves are checked at once, in chunks
     // that double while none holds (1, 2, 4, 8: many trials in flight where poses keep failing,
@@ -647,25 +647,33 @@ class TreeSearch {
 };
 
 // A returned hanging pose moved out of the area, `gap` beyond it (penetration.h,
-// clearingShift), with its path and pre-place pose (its contacts stay where it touches, where
+// clearedPose), with its path and pre-place pose (its contacts stay where it touches, where
 // it swings back to when let go): the guard lets it lie up to a contact distance inside a wall
 // it swung against, where a robot's release collides (MuJoCo threw such a mug off a J-hook;
-// doc/method.md, "The returned pose is clear of the area"). One that no move of at most 3
-// sphere radii clears is jammed (out of one surface is into another): not stable.
+// doc/method.md, "The returned pose is clear of the area"). Where no shift clears it, a turn of
+// up to 4 degrees about its support first; one that neither clears within 3 sphere radii is
+// not stable.
 void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, std::vector<Candidate>& candidates) {
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = m.am->R_GW;
+  const double max_shift = 3.0 * m.rad.r + 2 * gap;
   for (Candidate& c : candidates) {
-    if (!c.hanging) continue;
-    const std::optional<V3> s = clearingShift(m.om, *m.am, toRigid(X_GW * c.X_WO), gap, 3.0 * m.rad.r + 2 * gap);
-    if (!s) {
+    if (!c.hanging || c.contacts.empty()) continue;
+    const Eigen::Isometry3d X_GO = X_GW * c.X_WO;
+    // Turned, where it must be, about its support: the highest contact.
+    Eigen::Vector3d pivot = X_GW * c.contacts.front().p_W;
+    for (const ContactPoint& p : c.contacts)
+      if ((X_GW * p.p_W).z() > pivot.z()) pivot = X_GW * p.p_W;
+    const std::optional<Rigid> Y = clearedPose(m.om, *m.am, toRigid(X_GO), toV3(pivot), gap, max_shift);
+    if (!Y) {
       c.stable = false;
       continue;
     }
-    const Eigen::Vector3d shift = m.am->R_GW.transpose() * toEigen(*s);
-    c.X_WO.pretranslate(shift);
-    for (Eigen::Isometry3d& X : c.intermediate_poses) X.pretranslate(shift);
-    c.placement.pre_place_W.pretranslate(shift);
+    // The move, applied to the pose, its path and its pre-place pose (frame W).
+    const Eigen::Isometry3d D_W = X_GW.inverse() * toIsometry(*Y) * X_GO.inverse() * X_GW;
+    c.X_WO = D_W * c.X_WO;
+    for (Eigen::Isometry3d& X : c.intermediate_poses) X = D_W * X;
+    c.placement.pre_place_W = D_W * c.placement.pre_place_W;
     if (c.has_gripper_pose) c.X_WF = c.X_WO * config.grasp;
   }
   std::stable_partition(candidates.begin(), candidates.end(), [](const Candidate& c) { return c.stable; });

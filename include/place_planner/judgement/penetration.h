@@ -45,4 +45,12 @@ Penetration penetration(const ObjectModel& object, const AreaModel& area, const 
 std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO, double gap,
                                 double max_shift, int max_steps = 6);
 
+// The pose (G) out of the area that is nearest X_GO: clearingShift's, or, where no shift clears
+// it (jammed between two surfaces, a shift out of one pushing it into the other: a basket's
+// handle in a J-hook's turned-up tip, its back in the wall), the object turned first by 1, 2
+// or 4 degrees about an axis of G through `pivot` (its support), the least turn that a shift
+// then clears. None when neither clears it.
+std::optional<Rigid> clearedPose(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
+                                 const V3& pivot, double gap, double max_shift);
+
 }  // namespace place_planner

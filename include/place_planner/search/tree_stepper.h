@@ -26,6 +26,9 @@ struct PegLine {
   // m: the loop's room round the peg (its largest circle less the peg's half width); 0: unknown.
   // A swing's turn may carry the loop across the peg no farther (swingStep's pivot).
   double room = 0;
+  // Each swing move is checked by all the object's probes (ObjectModel::probes), not only its
+  // vertices: a tree run again after its rest was found inside the area (streamRoots).
+  bool probe_swing = false;
   bool known() const { return axis.squaredNorm() > 0; }
 };
 
@@ -84,6 +87,7 @@ struct TreeLeaf {
   bool rolled = false;  // it came to rest at the bottom of a roll (rollStep)
   bool fell = false;    // the tree was cut while falling over a ledge (TreeContext::fall_tip)
   bool hanging = false;  // its last stability test found every contact above the centre of mass
+  bool inside = false;   // the result's penetration guard found it inside the area
   PegLine peg;  // its tree's peg (TreeNode), if any
 };
 

@@ -1,6 +1,8 @@
 #include "place_planner/judgement/penetration.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "place_planner/kernels/placement_kernels.h"
@@ -93,6 +95,25 @@ std::optional<V3> clearingShift(const ObjectModel& object, const AreaModel& area
     shift = shift + (depth[deepest] + gap) * normal[deepest];
     if (norm(shift) > max_shift) break;
   }
+  return std::nullopt;
+}
+
+std::optional<Rigid> clearedPose(const ObjectModel& object, const AreaModel& area, const Rigid& X_GO,
+                                 const V3& pivot, double gap, double max_shift) {
+  auto shifted = [](Rigid X, const V3& s) {
+    X.t = X.t + s;
+    return X;
+  };
+  if (const std::optional<V3> s = clearingShift(object, area, X_GO, gap, max_shift)) return shifted(X_GO, *s);
+  const Eigen::Vector3d p = toEigen(pivot);
+  for (const double deg : {1.0, 2.0, 4.0})
+    for (int a = 0; a < 6; ++a) {
+      const Eigen::Vector3d axis = (a % 2 ? -1.0 : 1.0) * Eigen::Vector3d::Unit(a / 2);
+      const Eigen::Isometry3d T =
+          Eigen::Translation3d(p) * Eigen::AngleAxisd(deg * M_PI / 180.0, axis) * Eigen::Translation3d(-p);
+      const Rigid Y = toRigid(T * toIsometry(X_GO));
+      if (const std::optional<V3> s = clearingShift(object, area, Y, gap, max_shift)) return shifted(Y, *s);
+    }
   return std::nullopt;
 }
 

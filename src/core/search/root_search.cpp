@@ -81,6 +81,15 @@ void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O,
                  const std::function<bool(int, int)>& after_step) {
   int next = 0;
   const int first_batch = std::max(4, batch / 6);
+  // Where no hanging pose is stable, the hanging trees whose rests the result's guard found
+  // inside the area run once more with each swing move checked by all the object's probes
+  // (PegLine::probe_swing): a basket's box passed a 12 mm arm between its corner vertices. Only
+  // then: a mug swung by its vertices past a round post ends where Bullet keeps it, and stopped
+  // at the post by the probes it rested tilted against it, where Bullet turned it off.
+  std::vector<char> again(static_cast<size_t>(roots.size()), 0);
+  std::vector<int> inside;  // roots to run again
+  bool hangs = false;
+  size_t seen = leaves.size();
   for (int step = 0, target = first_batch;; ++step) {
     if (step > 0 && step % 2 == 0) target = std::min(batch, 2 * target);
     while (static_cast<int>(stepper.active()) < target && next < roots.size()) {
@@ -89,9 +98,25 @@ void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O,
                       h ? PegLine{h->peg_point, -h->approach, h->turned, h->room} : PegLine{});
       ++next;
     }
+    if (stepper.empty() && next >= roots.size() && !hangs) {
+      for (const int k : inside) {
+        const HangingStart* h = roots.hanging(k);
+        PegLine peg{h->peg_point, -h->approach, h->turned, h->room};
+        peg.probe_swing = true;
+        stepper.addRoot(roots.pose(k), k, com_O, roots.direction(k), roots.tmax(k), peg);
+      }
+      inside.clear();
+    }
     if (stepper.empty()) break;
     stepper.step(leaves);
     if (!after_step(next, static_cast<int>(stepper.openRoots().size()))) break;
+    for (; seen < leaves.size(); ++seen) {
+      const TreeLeaf& l = leaves[seen];
+      hangs = hangs || (l.stable && l.hanging);
+      if (!l.inside || !roots.hanging(l.root) || l.peg.probe_swing || again[static_cast<size_t>(l.root)]) continue;
+      again[static_cast<size_t>(l.root)] = 1;
+      inside.push_back(l.root);
+    }
   }
 }
 

@@ -491,15 +491,16 @@ void TreeStepper::swingStep() {
     // The lowest move that leaves the object out of the area: lowered straight down, a turn can
     // still push it sideways into a wall (a ring into the board behind its peg, a mug into a
     // mug tree's trunk, which only a sideways ray sees), which the result's penetration guard
-    // would then reject; the next lowest is taken instead. By the vertices alone: the result's
-    // guard looks at all the probes (penetration.h), at 4-5 times the swing's time if each move did.
+    // would then reject; the next lowest is taken instead. By the vertices alone (the result's
+    // guard looks at all the probes, penetration.h, at 4-5 times the swing's time if each move
+    // did), unless the tree runs again because its rest was inside (PegLine::probe_swing).
     for (int tries = 0; tries < kMoves; ++tries) {
       best = 0;
       for (int k = 1; k < kMoves; ++k)
         if (h[k] < h[best]) best = k;
       if (best == 0 || ctx_.penetration_limit <= 0 || h[best] >= h[0] - kSwingDrop) break;
       const Rigid Y = translated(q[i0 + best].X_GO, v3(0, 0, -d[i0 + best]));
-      if (penetration(ctx_.om, ctx_.am, Y, 0.03, false).within(ctx_.penetration_limit, ctx_.penetration_sideways)) break;
+      if (penetration(ctx_.om, ctx_.am, Y, 0.03, n.peg.probe_swing).within(ctx_.penetration_limit, ctx_.penetration_sideways)) break;
       h[best] = kInf;
     }
     ++n.swings;

@@ -534,6 +534,35 @@ TEST(Penetration, TheClearingShiftTakesABoxOutOfAWallAndAFloor) {
   EXPECT_FALSE(clearingShift(om, walls, toRigid(X), gap, 0.01));
 }
 
+// A 10 cm rod tilted 45 degrees between two walls, each end 0.5 mm in a wall: out of one is
+// into the other, so no shift clears it, but a turn of a degree or two about its middle
+// (towards upright) does, and clearedPose takes the least such turn.
+TEST(Penetration, AJammedRodIsClearedByATurnNoShiftGives) {
+  ObjectModel om = buildObjectModel(scenes::box(0.10, 0.01, 0.01), 0.001);
+  addProbes(om, 0.004);
+  const double half = 0.5 * (0.10 + 0.01) * std::sqrt(0.5) - 0.0005;  // the walls' inner faces
+  const Mesh slot = scenes::merge({scenes::box(0.02, 0.2, 0.3, {-half - 0.01, 0, 0.1}), scenes::box(0.02, 0.2, 0.3, {half + 0.01, 0, 0.1})},
+                                  "slot");
+  const AreaModel walls = buildAreaModel(slot, {0, 0, -1}, 0.001, 0.00175, 0.00175);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  X.translation() = Eigen::Vector3d(0, 0, 0.1);
+  ASSERT_NEAR(penetrationDepth(om, walls, toRigid(X)), 0.0005, 2e-4);
+  const double gap = 0.0005;
+  EXPECT_FALSE(clearingShift(om, walls, toRigid(X), gap, 0.01)) << "a shift cleared it";
+  const std::optional<Rigid> Y = clearedPose(om, walls, toRigid(X), toV3(X.translation()), gap, 0.01);
+  ASSERT_TRUE(Y) << "no turn cleared it";
+  EXPECT_LE(penetrationDepth(om, walls, *Y), 1e-5);
+  const double turned = rotationAngle(*Y, toRigid(X)) * 180 / M_PI;
+  EXPECT_GT(turned, 0.5);
+  EXPECT_LE(turned, 4.0 + 1e-9);
+  EXPECT_LT((toEigen(Y->t) - X.translation()).norm(), 0.005) << "moved far from where it was";
+  // Already clear: the same pose back.
+  const std::optional<Rigid> same = clearedPose(om, walls, *Y, Y->t, gap, 0.01);
+  ASSERT_TRUE(same);
+  EXPECT_EQ(rotationAngle(*same, *Y), 0.0);
+}
+
 TEST(Ranking, TheLargerTippingMarginRanksFirstAmongEqualPoses) {
   // Two stable poses of a 10 cm cube on a flat top, alike in Q, contacts and robust share; one
   // tips off after 2 degrees of tilt, the other after 8. The tie-break alone (nearer the frame's

@@ -63,7 +63,9 @@ namespace place_planner {
 // places, so a pose that settles in a few steps is not held up by a long tree. The batch starts
 // at first_batch and doubles every other step up to `batch`. Each tree depends on its root
 // only: the leaves are the same whatever the batch. `after_step(leaves)` is called after every
-// batched step with the open roots counted; false stops the search.
+// batched step with the open roots counted; false stops the search. When every root has ended
+// and no hanging leaf is stable, the hanging roots whose leaves after_step marked inside the
+// area run once more, their swings checked by all the object's probes (PegLine::probe_swing).
 void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O, int batch,
                  std::vector<TreeLeaf>& leaves,
                  const std::function<bool(int roots_started, int roots_open)>& after_step);

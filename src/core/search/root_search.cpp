@@ -4,7 +4,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 namespace place_planner {
 
@@ -87,6 +86,12 @@ void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O,
   // (PegLine::probe_swing): a basket's box passed a 12 mm arm between its corner vertices. Only
   // then: a mug swung by its vertices past a round post ends where Bullet keeps it, and stopped
   // at the post by the probes it rested tilted against it, where Bullet turned it off.
+  auto pegOf = [&](int k, bool probe_swing) {
+    const HangingStart* h = roots.hanging(k);
+    PegLine peg = h ? PegLine{h->peg_point, -h->approach, h->turned, h->room} : PegLine{};
+    peg.probe_swing = probe_swing;
+    return peg;
+  };
   std::vector<char> again(static_cast<size_t>(roots.size()), 0);
   std::vector<int> inside;  // roots to run again
   bool hangs = false;
@@ -94,18 +99,12 @@ void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O,
   for (int step = 0, target = first_batch;; ++step) {
     if (step > 0 && step % 2 == 0) target = std::min(batch, 2 * target);
     while (static_cast<int>(stepper.active()) < target && next < roots.size()) {
-      const HangingStart* h = roots.hanging(next);
-      stepper.addRoot(roots.pose(next), next, com_O, roots.direction(next), roots.tmax(next),
-                      h ? PegLine{h->peg_point, -h->approach, h->turned, h->room} : PegLine{});
+      stepper.addRoot(roots.pose(next), next, com_O, roots.direction(next), roots.tmax(next), pegOf(next, false));
       ++next;
     }
     if (stepper.empty() && next >= roots.size() && !hangs) {
-      for (const int k : inside) {
-        const HangingStart* h = roots.hanging(k);
-        PegLine peg{h->peg_point, -h->approach, h->turned, h->room};
-        peg.probe_swing = true;
-        stepper.addRoot(roots.pose(k), k, com_O, roots.direction(k), roots.tmax(k), peg);
-      }
+      for (const int k : inside)
+        stepper.addRoot(roots.pose(k), k, com_O, roots.direction(k), roots.tmax(k), pegOf(k, true));
       inside.clear();
     }
     if (stepper.empty()) break;

@@ -113,6 +113,8 @@ inline V3 toV3(const Eigen::Vector3d& p) { return v3(p.x(), p.y(), p.z()); }
 inline Eigen::Vector3d toEigen(V3 p) { return Eigen::Vector3d(p.x, p.y, p.z); }
 Rigid toRigid(const Eigen::Isometry3d& T);
 Eigen::Isometry3d toIsometry(const Rigid& T);
+// Rotation by `angle` about the axis (s, d) applied after X.
+Rigid rotatedAbout(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector3d& d, double angle);
 
 // Angle (rad) of the rotation between two orientations (host only: scene.cpp).
 double rotationAngle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);

@@ -150,7 +150,4 @@ class TreeStepper {
   std::vector<TreeNode> translate_, contact_, rotating_, rolling_, rocking_, swinging_;
 };
 
-// Rotation by `angle` about the axis (s, d) applied after X.
-Rigid rotatedAbout(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector3d& d, double angle);
-
 }  // namespace place_planner

@@ -1,6 +1,5 @@
 #include "place_planner/judgement/penetration.h"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -105,13 +104,9 @@ std::optional<Rigid> clearedPose(const ObjectModel& object, const AreaModel& are
     return X;
   };
   if (const std::optional<V3> s = clearingShift(object, area, X_GO, gap, max_shift)) return shifted(X_GO, *s);
-  const Eigen::Vector3d p = toEigen(pivot);
   for (const double deg : {1.0, 2.0, 4.0})
     for (int a = 0; a < 6; ++a) {
-      const Eigen::Vector3d axis = (a % 2 ? -1.0 : 1.0) * Eigen::Vector3d::Unit(a / 2);
-      const Eigen::Isometry3d T =
-          Eigen::Translation3d(p) * Eigen::AngleAxisd(deg * M_PI / 180.0, axis) * Eigen::Translation3d(-p);
-      const Rigid Y = toRigid(T * toIsometry(X_GO));
+      const Rigid Y = rotatedAbout(X_GO, toEigen(pivot), (a % 2 ? -1.0 : 1.0) * Eigen::Vector3d::Unit(a / 2), deg * M_PI / 180.0);
       if (const std::optional<V3> s = clearingShift(object, area, Y, gap, max_shift)) return shifted(Y, *s);
     }
   return std::nullopt;

@@ -27,6 +27,13 @@ Eigen::Isometry3d toIsometry(const Rigid& r) {
   return T;
 }
 
+Rigid rotatedAbout(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector3d& d, double angle) {
+  Eigen::Isometry3d Rot = Eigen::Isometry3d::Identity();
+  Rot.linear() = Eigen::AngleAxisd(angle, d.normalized()).toRotationMatrix();
+  Rot.translation() = s - Rot.linear() * s;
+  return toRigid(Rot * toIsometry(X));
+}
+
 Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W) {
   // Minimal rotation taking -d_g to +z; identity for the default d_g = -z.
   const Eigen::Vector3d up = -gravity_W.normalized();

@@ -92,8 +92,7 @@ void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O,
     peg.probe_swing = probe_swing;
     return peg;
   };
-  std::vector<char> again(static_cast<size_t>(roots.size()), 0);
-  std::vector<int> inside;  // roots to run again
+  std::vector<char> again(static_cast<size_t>(roots.size()), 0);  // 1: to run again, 2: run again
   bool hangs = false;
   size_t seen = leaves.size();
   for (int step = 0, target = first_batch;; ++step) {
@@ -102,20 +101,20 @@ void streamRoots(const RootSearch& roots, TreeStepper& stepper, const V3& com_O,
       stepper.addRoot(roots.pose(next), next, com_O, roots.direction(next), roots.tmax(next), pegOf(next, false));
       ++next;
     }
-    if (stepper.empty() && next >= roots.size() && !hangs) {
-      for (const int k : inside)
-        stepper.addRoot(roots.pose(k), k, com_O, roots.direction(k), roots.tmax(k), pegOf(k, true));
-      inside.clear();
-    }
+    if (stepper.empty() && next >= roots.size() && !hangs)
+      for (int k = 0; k < roots.size(); ++k)
+        if (again[static_cast<size_t>(k)] == 1) {
+          again[static_cast<size_t>(k)] = 2;
+          stepper.addRoot(roots.pose(k), k, com_O, roots.direction(k), roots.tmax(k), pegOf(k, true));
+        }
     if (stepper.empty()) break;
     stepper.step(leaves);
     if (!after_step(next, static_cast<int>(stepper.openRoots().size()))) break;
     for (; seen < leaves.size(); ++seen) {
       const TreeLeaf& l = leaves[seen];
       hangs = hangs || (l.stable && l.hanging);
-      if (!l.inside || !roots.hanging(l.root) || l.peg.probe_swing || again[static_cast<size_t>(l.root)]) continue;
-      again[static_cast<size_t>(l.root)] = 1;
-      inside.push_back(l.root);
+      if (l.inside && roots.hanging(l.root) && !l.peg.probe_swing && !again[static_cast<size_t>(l.root)])
+        again[static_cast<size_t>(l.root)] = 1;
     }
   }
 }

@@ -160,13 +160,6 @@ void addTime(double* slot, Clock::time_point t0) {
 
 }  // namespace
 
-Rigid rotatedAbout(const Rigid& X, const Eigen::Vector3d& s, const Eigen::Vector3d& d, double angle) {
-  Eigen::Isometry3d Rot = Eigen::Isometry3d::Identity();
-  Rot.linear() = Eigen::AngleAxisd(angle, d.normalized()).toRotationMatrix();
-  Rot.translation() = s - Rot.linear() * s;
-  return toRigid(Rot * toIsometry(X));
-}
-
 TreeStepper::TreeStepper(const TreeContext& ctx) : ctx_(ctx), diag_(norm(ctx.am.bounds.hi - ctx.am.bounds.lo)) {}
 
 void TreeStepper::addRoot(const Rigid& X_GO, int root, const V3& com_O, const V3& direction, double tmax,

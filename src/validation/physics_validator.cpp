@@ -385,6 +385,42 @@ std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const V
   return makeConvexPieces(mesh, config);
 }
 
+double convexity(const Mesh& mesh) { return meshConvexity(mesh); }
+
+void clipToHull(std::vector<std::vector<Eigen::Vector3d>>& pieces, const std::vector<Eigen::Vector3d>& points) {
+  std::vector<double> xyz;
+  Eigen::Vector3d mid = Eigen::Vector3d::Zero();
+  for (const auto& p : points) {
+    for (int k = 0; k < 3; ++k) xyz.push_back(p[k]);
+    mid += p;
+  }
+  if (points.size() < 4) return;
+  mid /= static_cast<double>(points.size());
+  btConvexHullComputer ch;
+  ch.compute(xyz.data(), 3 * sizeof(double), static_cast<int>(points.size()), 0, 0);
+  std::vector<std::pair<Eigen::Vector3d, double>> planes;  // outward unit normal, offset
+  for (int f = 0; f < ch.faces.size(); ++f) {
+    const btConvexHullComputer::Edge* e0 = &ch.edges[ch.faces[f]];
+    const btConvexHullComputer::Edge* e1 = e0->getNextEdgeOfFace();
+    auto at = [&](int v) { return Eigen::Vector3d(ch.vertices[v].x(), ch.vertices[v].y(), ch.vertices[v].z()); };
+    const Eigen::Vector3d a = at(e0->getSourceVertex()), b = at(e1->getSourceVertex()), c = at(e1->getTargetVertex());
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() < 1e-15) continue;
+    n.normalize();
+    if (n.dot(a - mid) < 0) n = -n;
+    planes.emplace_back(n, n.dot(a));
+  }
+  // Alternating projections onto the faces' half-spaces: a slab corner a little outside comes
+  // back onto the hull within a few rounds.
+  for (auto& piece : pieces)
+    for (auto& p : piece)
+      for (int round = 0; round < 4; ++round)
+        for (const auto& [n, d] : planes) {
+          const double out = n.dot(p) - d;
+          if (out > 0) p -= out * n;
+        }
+}
+
 BoxBody boxBody(const Mesh& object_O, double density) {
   const Eigen::Vector3d ext = object_O.properties.bounds_max - object_O.properties.bounds_min;
   BoxBody b;

@@ -221,6 +221,12 @@ double remainingBudgetMs(double plan_budget_ms, double used_ms);
 // inwards (against its normal) by config.piece_thickness, less where the other side is nearer,
 // and inset by the margins (config.margin: Bullet's; 0 for an engine without margins).
 std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const ValidatorConfig& config);
+// A closed mesh's volume over its convex hull's (0 for an open mesh).
+double convexity(const Mesh& mesh);
+// Moves every point of the pieces that lies outside the convex hull of `points` onto it: a
+// slab thickened inwards at an edge sharper than a right angle (a cone's rim) otherwise reaches
+// out through the other face.
+void clipToHull(std::vector<std::vector<Eigen::Vector3d>>& pieces, const std::vector<Eigen::Vector3d>& points);
 
 // The object's rigid body in both engines: mass = density x bounding-box volume, and the
 // principal moments (kg m^2, about c_O along the axes of O) of that solid box.

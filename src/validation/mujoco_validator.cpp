@@ -127,7 +127,8 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   // a mug's handle hangs, and MuJoCo threw the mug off. At 0.8 the ragged outlines of curved
   // pieces were cut too (a key ring on the pegboard: 3x the pieces, 3x the time).
   pc.piece_min_fill = 0.6;
-  for (const Loop& l : findLoops(object_O)) pc.piece_max_size = std::min(pc.piece_max_size, 0.5 * l.radius);
+  const std::vector<Loop> loops = findLoops(object_O);
+  for (const Loop& l : loops) pc.piece_max_size = std::min(pc.piece_max_size, 0.5 * l.radius);
   // The area's slabs: its surface with 2 cm under it (less in thin walls), pieces twice as large
   // as the object's. A slab's contact normal stays true while it is about as thick as it is
   // long (subdivided() above): at 1 cm under 4 cm pieces a YCB bowl resting on the true table
@@ -142,7 +143,7 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   // a cone) has its slabs kept inside that hull. A slab thickened inwards along a cone's side
   // reached 3.6 mm below its base at the rim, and MuJoCo tipped the cone standing on its base
   // 21 degrees (doc/validation.md, "Held-out objects").
-  if (convexity(object_O) >= config.convex_volume_ratio && findLoops(object_O).empty())
+  if (loops.empty() && convexity(object_O) >= config.convex_volume_ratio)
     clipToHull(object_pieces, object_O.vertices);
   std::vector<std::vector<Eigen::Vector3d>> area_pieces = convexPieces(subdivided(area_W, 0.5 * ac.piece_max_size), ac);
 

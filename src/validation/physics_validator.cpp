@@ -200,11 +200,16 @@ std::vector<Eigen::Vector2d> projected(const Mesh& m, const std::vector<int>& gr
 
 // btConvexHullComputer shrinks a hull by at most this share of its inner radius.
 constexpr double kShrinkClamp = 0.45;
+// m^2: a triangle this small (sides of about 0.14 mm) seeds no piece; it may join a
+// neighbour's. Its normal is its mesh's noise: a sliver at the full-resolution YCB mug's rim,
+// thickened 1 cm along its normal, reached 8 mm out through the rim and MuJoCo threw the mug
+// standing on it (test_mujoco_validator, doc/validation.md).
+constexpr double kSliverArea = 1e-8;
 
 // Groups neighbouring triangles (sharing an edge) of similar normal into pieces; each piece
 // becomes the point set of a convex slab: its vertices plus the same moved inwards (against the
 // piece's area-weighted normal) by a thickness (piece_thickness, or less where the opposite
-// side of the object is closer). Zero-area triangles are skipped.
+// side of the object is closer). Zero-area triangles are skipped, slivers seed none.
 std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const ValidatorConfig& c) {
   const int nt = static_cast<int>(m.triangles.size());
   std::vector<Eigen::Vector3d> normal(nt), centroid(nt);
@@ -265,7 +270,7 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
   };
   std::vector<std::vector<int>> groups;
   for (int seed = 0; seed < nt; ++seed) {
-    if (used[seed] || area[seed] <= 0) continue;
+    if (used[seed] || area[seed] <= kSliverArea) continue;
     std::vector<std::pair<std::vector<int>, double>> todo;  // a group, the size it was grown to
     todo.emplace_back(grow(seed, c.piece_max_size), c.piece_max_size);
     while (!todo.empty()) {

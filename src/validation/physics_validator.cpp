@@ -333,27 +333,35 @@ std::vector<std::vector<Eigen::Vector3d>> makeConvexPieces(const Mesh& m, const 
   return pieces;
 }
 
-// Volume of the convex hull of the points (fan over each hull face, apex at the first vertex).
-double hullVolume(const std::vector<Eigen::Vector3d>& pts) {
+// The convex hull of the points (Bullet's btConvexHullComputer): each face as its vertices in
+// order; empty when the hull has no volume.
+std::vector<std::vector<Eigen::Vector3d>> hullFaces(const std::vector<Eigen::Vector3d>& pts) {
   std::vector<double> xyz;
   for (const auto& p : pts)
     for (int k = 0; k < 3; ++k) xyz.push_back(p[k]);
   btConvexHullComputer ch;
   ch.compute(xyz.data(), 3 * sizeof(double), static_cast<int>(pts.size()), 0, 0);
-  if (ch.vertices.size() < 4) return 0.0;
-  const btVector3 apex = ch.vertices[0];
-  double vol = 0.0;
+  std::vector<std::vector<Eigen::Vector3d>> faces;
+  if (ch.vertices.size() < 4) return faces;
+  auto at = [&](int v) { return Eigen::Vector3d(ch.vertices[v].x(), ch.vertices[v].y(), ch.vertices[v].z()); };
   for (int f = 0; f < ch.faces.size(); ++f) {
     const btConvexHullComputer::Edge* e0 = &ch.edges[ch.faces[f]];
-    const btVector3 a = ch.vertices[e0->getSourceVertex()];
-    const btConvexHullComputer::Edge* e = e0->getNextEdgeOfFace();
-    while (e->getTargetVertex() != e0->getSourceVertex()) {
-      const btVector3 b = ch.vertices[e->getSourceVertex()];
-      const btVector3 c = ch.vertices[e->getTargetVertex()];
-      vol += std::abs((a - apex).dot((b - apex).cross(c - apex))) / 6.0;
-      e = e->getNextEdgeOfFace();
-    }
+    std::vector<Eigen::Vector3d> face{at(e0->getSourceVertex())};
+    for (const btConvexHullComputer::Edge* e = e0->getNextEdgeOfFace(); e != e0; e = e->getNextEdgeOfFace())
+      face.push_back(at(e->getSourceVertex()));
+    faces.push_back(std::move(face));
   }
+  return faces;
+}
+
+// Volume of the convex hull of the points (a fan over each hull face, apex at a hull vertex).
+double hullVolume(const std::vector<Eigen::Vector3d>& pts) {
+  const std::vector<std::vector<Eigen::Vector3d>> faces = hullFaces(pts);
+  if (faces.empty()) return 0.0;
+  const Eigen::Vector3d apex = faces[0][0];
+  double vol = 0.0;
+  for (const auto& f : faces)
+    for (size_t i = 1; i + 1 < f.size(); ++i) vol += std::abs((f[0] - apex).dot((f[i] - apex).cross(f[i + 1] - apex))) / 6.0;
   return vol;
 }
 
@@ -393,27 +401,18 @@ std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const V
 double convexity(const Mesh& mesh) { return meshConvexity(mesh); }
 
 void clipToHull(std::vector<std::vector<Eigen::Vector3d>>& pieces, const std::vector<Eigen::Vector3d>& points) {
-  std::vector<double> xyz;
-  Eigen::Vector3d mid = Eigen::Vector3d::Zero();
-  for (const auto& p : points) {
-    for (int k = 0; k < 3; ++k) xyz.push_back(p[k]);
-    mid += p;
-  }
   if (points.size() < 4) return;
+  Eigen::Vector3d mid = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mid += p;
   mid /= static_cast<double>(points.size());
-  btConvexHullComputer ch;
-  ch.compute(xyz.data(), 3 * sizeof(double), static_cast<int>(points.size()), 0, 0);
   std::vector<std::pair<Eigen::Vector3d, double>> planes;  // outward unit normal, offset
-  for (int f = 0; f < ch.faces.size(); ++f) {
-    const btConvexHullComputer::Edge* e0 = &ch.edges[ch.faces[f]];
-    const btConvexHullComputer::Edge* e1 = e0->getNextEdgeOfFace();
-    auto at = [&](int v) { return Eigen::Vector3d(ch.vertices[v].x(), ch.vertices[v].y(), ch.vertices[v].z()); };
-    const Eigen::Vector3d a = at(e0->getSourceVertex()), b = at(e1->getSourceVertex()), c = at(e1->getTargetVertex());
-    Eigen::Vector3d n = (b - a).cross(c - a);
+  for (const auto& f : hullFaces(points)) {
+    if (f.size() < 3) continue;
+    Eigen::Vector3d n = (f[1] - f[0]).cross(f[2] - f[0]);
     if (n.norm() < 1e-15) continue;
     n.normalize();
-    if (n.dot(a - mid) < 0) n = -n;
-    planes.emplace_back(n, n.dot(a));
+    if (n.dot(f[0] - mid) < 0) n = -n;
+    planes.emplace_back(n, n.dot(f[0]));
   }
   // Alternating projections onto the faces' half-spaces: a slab corner a little outside comes
   // back onto the hull within a few rounds.

@@ -90,7 +90,43 @@ void appendMesh(std::ostringstream& xml, const std::string& name, const std::vec
   xml << "\"/>\n";
 }
 
+// Pieces without margins (MuJoCo has none to make up for); the object's no larger than half
+// its narrowest loop's radius: a hull must not bridge a handle's opening (as for Bullet), and
+// a piece as long as the radius still bulges into it (a key ring of 7 mm wire bent to 2.2 cm
+// started 1.1 cm inside the rail it hung on, and MuJoCo threw it off; at half, no contact:
+// held-out hanging racks in both engines 6 -> 11 of 25, doc/validation.md).
+ValidatorConfig objectPieceConfig(const ValidatorConfig& config, double piece_size, const std::vector<Loop>& loops) {
+  ValidatorConfig pc = config;
+  pc.margin = 0.0;
+  pc.piece_max_triangles = 1000;  // pieces bounded by their size (a fine mesh's too)
+  pc.piece_max_size = std::min(config.piece_max_size, piece_size);
+  // A piece whose triangles cover under 0.6 of its outline is cut again: a bent wire's flat
+  // flank (a J-hook's arm and its turned-up tip) made one L whose hull filled the corner where
+  // a mug's handle hangs, and MuJoCo threw the mug off. At 0.8 the ragged outlines of curved
+  // pieces were cut too (a key ring on the pegboard: 3x the pieces, 3x the time).
+  pc.piece_min_fill = 0.6;
+  for (const Loop& l : loops) pc.piece_max_size = std::min(pc.piece_max_size, 0.5 * l.radius);
+  return pc;
+}
+
+std::vector<std::vector<Eigen::Vector3d>> piecesOf(const Mesh& object_O, const ValidatorConfig& config,
+                                                  const ValidatorConfig& pc, const std::vector<Loop>& loops) {
+  std::vector<std::vector<Eigen::Vector3d>> pieces = convexPieces(subdivided(object_O, 0.5 * pc.piece_max_size), pc);
+  // A nearly convex closed object without a loop (the one hull Bullet simulates: a box, a bottle,
+  // a cone) has its slabs kept inside that hull. A slab thickened inwards along a cone's side
+  // reached 3.6 mm below its base at the rim, and MuJoCo tipped the cone standing on its base
+  // 21 degrees (doc/validation.md, "Held-out objects").
+  if (loops.empty() && convexity(object_O) >= config.convex_volume_ratio) clipToHull(pieces, object_O.vertices);
+  return pieces;
+}
+
 }  // namespace
+
+std::vector<std::vector<Eigen::Vector3d>> mujocoObjectPieces(const Mesh& object_O, const ValidatorConfig& config,
+                                                             double piece_size) {
+  const std::vector<Loop> loops = findLoops(object_O);
+  return piecesOf(object_O, config, objectPieceConfig(config, piece_size, loops), loops);
+}
 
 struct MujocoValidator::Impl {
   ValidatorConfig cfg;
@@ -113,22 +149,8 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   d.cfg = config;
   d.c_O = object_O.properties.center_of_mass;
 
-  // Pieces without margins (MuJoCo has none to make up for); the object's no larger than half
-  // its narrowest loop's radius: a hull must not bridge a handle's opening (as for Bullet), and
-  // a piece as long as the radius still bulges into it (a key ring of 7 mm wire bent to 2.2 cm
-  // started 1.1 cm inside the rail it hung on, and MuJoCo threw it off; at half, no contact:
-  // held-out hanging racks in both engines 6 -> 11 of 25, doc/validation.md).
-  ValidatorConfig pc = config;
-  pc.margin = 0.0;
-  pc.piece_max_triangles = 1000;  // pieces bounded by their size (a fine mesh's too)
-  pc.piece_max_size = std::min(config.piece_max_size, piece_size);
-  // A piece whose triangles cover under 0.6 of its outline is cut again: a bent wire's flat
-  // flank (a J-hook's arm and its turned-up tip) made one L whose hull filled the corner where
-  // a mug's handle hangs, and MuJoCo threw the mug off. At 0.8 the ragged outlines of curved
-  // pieces were cut too (a key ring on the pegboard: 3x the pieces, 3x the time).
-  pc.piece_min_fill = 0.6;
   const std::vector<Loop> loops = findLoops(object_O);
-  for (const Loop& l : loops) pc.piece_max_size = std::min(pc.piece_max_size, 0.5 * l.radius);
+  const ValidatorConfig pc = objectPieceConfig(config, piece_size, loops);
   // The area's slabs: its surface with 2 cm under it (less in thin walls), pieces twice as large
   // as the object's. A slab's contact normal stays true while it is about as thick as it is
   // long (subdivided() above): at 1 cm under 4 cm pieces a YCB bowl resting on the true table
@@ -138,13 +160,7 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   ac.piece_max_size = 2.0 * piece_size;
   ac.piece_thickness = 0.02;
   ac.piece_full_depth_along = -config.gravity;  // floors and shelves: thick even where thin
-  std::vector<std::vector<Eigen::Vector3d>> object_pieces = convexPieces(subdivided(object_O, 0.5 * pc.piece_max_size), pc);
-  // A nearly convex closed object without a loop (the one hull Bullet simulates: a box, a bottle,
-  // a cone) has its slabs kept inside that hull. A slab thickened inwards along a cone's side
-  // reached 3.6 mm below its base at the rim, and MuJoCo tipped the cone standing on its base
-  // 21 degrees (doc/validation.md, "Held-out objects").
-  if (loops.empty() && convexity(object_O) >= config.convex_volume_ratio)
-    clipToHull(object_pieces, object_O.vertices);
+  std::vector<std::vector<Eigen::Vector3d>> object_pieces = piecesOf(object_O, config, pc, loops);
   std::vector<std::vector<Eigen::Vector3d>> area_pieces = convexPieces(subdivided(area_W, 0.5 * ac.piece_max_size), ac);
 
   const BoxBody body = boxBody(object_O, config.density);  // as Bullet's

@@ -120,24 +120,19 @@ TEST(MujocoValidator, ConeOnItsBaseStaysItsSlabsInsideItsHull) {
   EXPECT_TRUE(bullet.check(Eigen::Isometry3d::Identity()).confirmed);
 }
 
-// A triangle of a tenth of a millimetre seeds no slab: its normal is the scan's noise. The
+// A triangle of a tenth of a millimetre seeds no slab: its normal is the mesh's noise. The
 // full-resolution YCB mug has such slivers at its rim, and one, thickened 1 cm along its
 // normal, reached 8 mm out through the rim: stood on its rim, MuJoCo threw the mug 4 cm.
 TEST(MujocoValidator, SliversSeedNoSlabAndTheMugStandsOnItsRim) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
   const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025.ply");
-  ValidatorConfig pc;  // the MuJoCo model's object pieces (mujoco_validator.cpp)
-  pc.margin = 0.0;
-  pc.piece_max_triangles = 1000;
-  pc.piece_max_size = 0.02;
-  pc.piece_min_fill = 0.6;
-  const std::vector<std::vector<Eigen::Vector3d>> pieces = convexPieces(mug, pc);
+  const std::vector<std::vector<Eigen::Vector3d>> pieces = mujocoObjectPieces(mug);  // the model's own
   std::vector<std::vector<Eigen::Vector3d>> inside = pieces;
   clipToHull(inside, mug.vertices);  // each point moved onto the mug's hull where outside it
   double worst = 0.0;
   for (size_t i = 0; i < pieces.size(); ++i)
     for (size_t k = 0; k < pieces[i].size(); ++k) worst = std::max(worst, (pieces[i][k] - inside[i][k]).norm());
-  EXPECT_LT(worst, 0.001) << "a slab point " << worst << " m outside the mug's convex hull";
+  EXPECT_LT(worst, 0.002) << "a slab point " << worst << " m outside the mug's convex hull";
   // Upside down on its rim on the table, released 2 mm above: it stays in both engines.
   Eigen::Isometry3d X = tiltedX(180.0);
   double low = 1e9;

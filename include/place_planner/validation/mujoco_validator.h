@@ -21,6 +21,7 @@
 #pragma once
 #include <Eigen/Geometry>
 #include <memory>
+#include <vector>
 
 #include "place_planner/model/mesh.h"
 #include "place_planner/validation/physics_validator.h"
@@ -54,6 +55,12 @@ class MujocoValidator {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The object's convex pieces as the MuJoCo model gets them (frame O): split to half the piece
+// size, grown from seeds that are no slivers, kept inside the object's hull when it is nearly
+// convex without a loop. What the constructor builds; tests read the slabs through it.
+std::vector<std::vector<Eigen::Vector3d>> mujocoObjectPieces(const Mesh& object_O, const ValidatorConfig& config = {},
+                                                             double piece_size = 0.02);
 
 }  // namespace validation
 }  // namespace place_planner

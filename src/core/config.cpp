@@ -102,6 +102,8 @@ void validate(const PlannerConfig& c) {
           c.grasp.linear().determinant(), "a rigid transform (rotation determinant 1)");
   require(std::isfinite(c.scan_noise) && c.scan_noise >= 0 && c.scan_noise <= 0.05, "scan_noise", c.scan_noise,
           "0 .. 0.05 m");
+  require(std::isfinite(c.scan_unseen_reach) && c.scan_unseen_reach >= 0 && c.scan_unseen_reach <= 0.05,
+          "scan_unseen_reach", c.scan_unseen_reach, "0 .. 0.05 m");
   require(std::isfinite(c.merge_angle_deg) && c.merge_angle_deg >= 0, "merge_angle_deg",
           c.merge_angle_deg, ">= 0");
 }

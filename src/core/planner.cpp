@@ -738,9 +738,11 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   clearOfTheArea(*models, config, kResultClearance + (completion.completed() ? config.scan_noise : 0.0),
                  run.result.candidates);
   // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
-  // released scan_noise higher (config.h), with its path and pre-place pose.
-  if (completion.completed() && config.scan_noise > 0) {
-    const Eigen::Vector3d lift = -config.scan_noise * config.gravity.normalized();
+  // released higher by the scan's noise or by how far the unseen may reach, whichever is more
+  // (config.h scan_unseen_reach), with its path and pre-place pose.
+  const double cap_lift = std::max(config.scan_noise, config.scan_unseen_reach);
+  if (completion.completed() && cap_lift > 0) {
+    const Eigen::Vector3d lift = -cap_lift * config.gravity.normalized();
     for (Candidate& c : run.result.candidates) {
       if (c.support != SupportKind::kCompleted) continue;
       c.X_WO.pretranslate(lift);

@@ -298,6 +298,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("prefer_near", &p.prefer_near);
   r.read("min_edge_clearance", &p.min_edge_clearance);
   r.read("scan_noise", &p.scan_noise);
+  r.read("scan_unseen_reach", &p.scan_unseen_reach);
   try {
     p.rank_order = rankOrderFromName(rank_order);
     p.placement = placementKindFromString(placement);

@@ -139,6 +139,7 @@ const std::map<std::string, std::string> kFlagOfField = {
     {"retreat_min_distance", "--retreat-min-distance"},
     {"min_edge_clearance", "--min-edge-clearance"},
     {"scan_noise", "--scan-noise"},
+    {"scan_unseen_reach", "--scan-unseen-reach"},
     {"prefer_near", "--prefer-near"},
     {"grasp", "--grasp"},
 };
@@ -570,6 +571,10 @@ int main(int argc, char** argv) {
       ->type_name("x,y,z");
   app.add_option("--scan-noise", c.scan_noise,
                  "[m] uncertainty of a scanned surface: an open (scanned) object is released this much higher")
+      ->check(kFinite)
+      ->capture_default_str();
+  app.add_option("--scan-unseen-reach", c.scan_unseen_reach,
+                 "[m] how far a scan's unseen part may reach past a cap: a pose resting on one is released this much higher")
       ->check(kFinite)
       ->capture_default_str();
   app.add_option("--min-edge-clearance", c.min_edge_clearance, "[m] from a drop-off of the area, 0 = off")

@@ -235,10 +235,10 @@ TEST(Planner, MergesNearbyPoses) {
 // ------------------------------------------------------------------ real meshes
 TEST(PlannerShared, PlateStandsInDishRack) {
   PP_REQUIRE_SHARED_DATA();
-  GTEST_SKIP() << "not feasible at mu 0.2 on this rack (doc/validation.md, \"The plate in the rack\"): "
-                  "the plate's centre of mass stands 13 cm up, the pegs 7.7 cm; leaning on one row's "
-                  "tops, its centre of mass lies past their edge at any lean up to 54 degrees, so it "
-                  "turns over the pegs (the one statically stable slot pose found fell in Bullet)";
+  GTEST_SKIP() << "the planner does not reach and keep the plate standing in a slot: Bullet keeps it "
+                  "there (PhysicsValidator.PlateStandsInTheDishRackSlot), its foot against one peg "
+                  "row and its face on the other's tops, held along the slot by friction alone "
+                  "(doc/validation.md, \"Bullet keeps the plate standing in the rack\")";
   const Mesh plate = loadMesh(test::sharedData() + "/objects/plate_ycb029_1k.ply");
   const Mesh rack = loadMesh(test::sharedData() + "/areas/dish_rack.ply");
   PlannerConfig cfg;

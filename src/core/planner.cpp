@@ -739,12 +739,13 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
                  run.result.candidates);
   // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
   // released higher by the scan's noise or by how far the unseen may reach, whichever is more
-  // (config.h scan_unseen_reach), with its path and pre-place pose.
+  // (config.h scan_unseen_reach), with its path and pre-place pose. A hanging one is raised by
+  // the noise alone: its cap does not carry it, and a pose released higher falls onto its peg.
   const double cap_lift = std::max(config.scan_noise, config.scan_unseen_reach);
   if (completion.completed() && cap_lift > 0) {
-    const Eigen::Vector3d lift = -cap_lift * config.gravity.normalized();
     for (Candidate& c : run.result.candidates) {
       if (c.support != SupportKind::kCompleted) continue;
+      const Eigen::Vector3d lift = -(c.hanging ? config.scan_noise : cap_lift) * config.gravity.normalized();
       c.X_WO.pretranslate(lift);
       for (Eigen::Isometry3d& X : c.intermediate_poses) X.pretranslate(lift);
       c.placement.pre_place_W.pretranslate(lift);

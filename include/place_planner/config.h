@@ -119,8 +119,8 @@ struct PlannerConfig {
   // border. Stood on their caps, the shared upper scans' true objects reach 1.9-5.5 mm past the
   // lowest seen point (boxes' and a bottle's straight walls the most, the mug's rounded foot the
   // least); released 5 mm higher they start from 0.5 mm inside to 2.8 mm above the table. A
-  // candidate resting on a cap is released max(scan_noise, scan_unseen_reach) higher, with its
-  // path and pre-place pose.
+  // standing candidate resting on a cap is released max(scan_noise, scan_unseen_reach) higher,
+  // with its path and pre-place pose (a hanging one scan_noise higher: it would fall onto its peg).
   double scan_unseen_reach = 0.005;
   // Optional region (planning frame) the floor points must lie in; inactive when min > max.
   Eigen::Vector3d region_min{1.0, 1.0, 1.0};

@@ -152,22 +152,29 @@ TEST(Scans, BoxStandingOnItsCompletedBottomIsAllowedAndFlagged) {
   EXPECT_TRUE(check.confirmed) << "moved " << check.moved_m << " m, turned " << check.turned_deg << " deg";
 }
 
-// The mug scanned from above (bottom unseen), held upright: it stands upright, and the true mug
-// at that pose neither penetrates the table by more than 1 mm nor floats more than 3 mm above it.
-TEST(ScansShared, MugScannedFromAboveStandsUprightOnTheTrueTable) {
-  PP_VALIDATION_REQUIRE_SHARED_DATA();
+// The object's scan `scan` (data/scans/objects) planned held upright (orientation keep) on the
+// true table: its best stable pose stands upright, on `support` when given, and the true object
+// `truth` (data/objects) at that pose is near the table and stays put (expectStaysOnTheTrueTable).
+void expectStandsUprightOnTheTrueTable(const std::string& scan, const std::string& truth,
+                                       const SupportKind* support = nullptr) {
   const std::string d = validation_test::sharedData();
-  const Mesh scan = loadMesh(d + "/scans/objects/mug_ycb025_upper_scan.ply");
-  const Mesh mug = loadMesh(d + "/objects/mug_ycb025.ply");
   const Mesh table = loadMesh(d + "/areas/table.ply");
   PlannerConfig cfg;
   cfg.threads = 2;
   cfg.orientation = OrientationMode::kKeep;
-  const PlanResult r = Planner().plan(scan, table, cfg);
+  const PlanResult r = Planner().plan(loadMesh(d + "/scans/objects/" + scan), table, cfg);
   const Candidate* c = best(r);
   ASSERT_NE(c, nullptr) << "nothing stable";
+  if (support) EXPECT_EQ(c->support, *support);
   EXPECT_GT(c->X_WO.linear().col(2).z(), std::cos(5 * M_PI / 180)) << "not upright";
-  expectStaysOnTheTrueTable(mug, table, *c, cfg.friction);
+  expectStaysOnTheTrueTable(loadMesh(d + "/objects/" + truth), table, *c, cfg.friction);
+}
+
+// The mug scanned from above (bottom unseen), held upright: it stands upright, and the true mug
+// at that pose neither penetrates the table by more than 1 mm nor floats more than 3 mm above it.
+TEST(ScansShared, MugScannedFromAboveStandsUprightOnTheTrueTable) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  expectStandsUprightOnTheTrueTable("mug_ycb025_upper_scan.ply", "mug_ycb025.ply");
 }
 
 // The mustard bottle scanned from above, held upright: it stands on its completed bottom, and
@@ -177,19 +184,8 @@ TEST(ScansShared, MugScannedFromAboveStandsUprightOnTheTrueTable) {
 // started 3.2 mm inside the table.
 TEST(ScansShared, BottleScannedFromAboveIsReleasedClearOfTheTrueTable) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const std::string d = validation_test::sharedData();
-  const Mesh scan = loadMesh(d + "/scans/objects/mustard_ycb006_upper_scan.ply");
-  const Mesh mustard = loadMesh(d + "/objects/mustard_ycb006.ply");
-  const Mesh table = loadMesh(d + "/areas/table.ply");
-  PlannerConfig cfg;
-  cfg.threads = 2;
-  cfg.orientation = OrientationMode::kKeep;
-  const PlanResult r = Planner().plan(scan, table, cfg);
-  const Candidate* c = best(r);
-  ASSERT_NE(c, nullptr) << "nothing stable";
-  EXPECT_EQ(c->support, SupportKind::kCompleted);
-  EXPECT_GT(c->X_WO.linear().col(2).z(), std::cos(5 * M_PI / 180)) << "not upright";
-  expectStaysOnTheTrueTable(mustard, table, *c, cfg.friction);
+  const SupportKind completed = SupportKind::kCompleted;
+  expectStandsUprightOnTheTrueTable("mustard_ycb006_upper_scan.ply", "mustard_ycb006.ply", &completed);
 }
 
 // The mustard bottle seen in the hand, with one vertex of its flat bottom pushed 4.2 mm down (a

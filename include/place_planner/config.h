@@ -110,9 +110,9 @@ struct PlannerConfig {
   // Scanned input (model/completion.h): the uncertainty of a scanned surface, m. A structured-light
   // camera at arm's length (0.5-0.8 m) has an axial noise of 1.3-2 mm (sigma, Nguyen et al. 2012)
   // and fused scans of objects are within 1-4 mm at p95. Where the object's mesh is open (a scan:
-  // its open regions are capped), the goal, the intermediate and the pre-place poses are raised
-  // by this much against gravity, so the real object, whose unseen part may reach below the cap,
-  // is released clear of the area rather than inside it.
+  // its open regions are capped), a pose resting on a cap is raised by at least this much against
+  // gravity (scan_unseen_reach below), a hanging pose is moved this much farther out of the area,
+  // and the centre-of-mass trials and the despiking use it.
   double scan_noise = 0.002;
   // How far the part of a scan that was not seen may reach past a cap (m). A fused scan's surface
   // stops short of where it was last seen: the signed-distance band has no far side at an open

@@ -570,7 +570,7 @@ int main(int argc, char** argv) {
          "point for --rank-order nearest (planning frame)")
       ->type_name("x,y,z");
   app.add_option("--scan-noise", c.scan_noise,
-                 "[m] uncertainty of a scanned surface: an open (scanned) object is released this much higher")
+                 "[m] uncertainty of a scanned surface: a scanned object's hanging pose is cleared of the area by this much more")
       ->check(kFinite)
       ->capture_default_str();
   app.add_option("--scan-unseen-reach", c.scan_unseen_reach,

@@ -630,6 +630,41 @@ TEST(PhysicsValidator, PlateStandsInTheDishRackSlot) {
   }
 }
 
+// What a marker does in the YCB pen cup (8 cm across inside, 7.5 cm tall), the pose the planner
+// should find there (PlannerShared.MarkerGoesIntoThePenCup): let go upright onto the cup's floor,
+// it does not stand on its flat end (the floor's facets tilt 1-3 degrees under its 2 cm cap) but
+// tips over until it leans across the cup, its foot in the corner of floor and wall, its body on
+// the opposite rim, about 48 degrees from vertical, and stays there.
+TEST(PhysicsValidator, MarkerLetGoUprightInThePenCupLeansAcrossIt) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  const Mesh marker = loadMesh(validation_test::sharedData() + "/objects/marker_ycb040_1k.ply");
+  const Mesh cup = loadMesh(validation_test::sharedData() + "/areas/pen_cup_ycb065j_1k.ply");
+  const PhysicsValidator bullet(marker, cup, withFriction(0.2));
+  const Eigen::Vector3d k1 = marker.properties.k1(), c_O = marker.properties.center_of_mass;
+  const double rim = cup.properties.bounds_max.z(), floor = 0.008;  // m: the inner floor's height
+  for (const double y : {0.0, 0.01}) {
+    Eigen::Isometry3d X = pose(Eigen::Quaterniond::FromTwoVectors(k1, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+                               Eigen::Vector3d::Zero());
+    X.translation() = Eigen::Vector3d(0.0, y, 0.0) - X.linear() * c_O;
+    double low = 1e300;
+    for (const Eigen::Vector3d& v : marker.vertices) low = std::min(low, (X * v).z());
+    X.translation().z() += floor + 0.002 - low;  // upright, its end 2 mm over the floor
+    const DropResult d = bullet.drop(X);
+    const double lean = std::acos(std::abs((d.X_WO_rest.linear() * k1).z())) * 180.0 / M_PI;
+    EXPECT_GT(lean, 40.0) << "y " << y;
+    EXPECT_LT(lean, 55.0) << "y " << y;
+    double lo = 1e300, hi = -1e300;
+    for (const Eigen::Vector3d& v : marker.vertices) {
+      lo = std::min(lo, (d.X_WO_rest * v).z());
+      hi = std::max(hi, (d.X_WO_rest * v).z());
+    }
+    EXPECT_LT(lo, floor + 0.003) << "y " << y << ": its foot on the floor, deep below the rim";
+    EXPECT_GT(hi, rim) << "y " << y << ": leaning out over the rim";
+    const PoseCheck k = bullet.check(d.X_WO_rest);
+    EXPECT_TRUE(k.confirmed) << "y " << y << ": moved " << k.moved_m << " m, turned " << k.turned_deg << " deg";
+  }
+}
+
 }  // namespace
 }  // namespace validation
 }  // namespace place_planner

@@ -83,6 +83,31 @@ Mesh subdivided(const Mesh& mesh, double max_edge) {
   return buildMesh(v, out, "subdivided mesh");
 }
 
+// A scan of an area may be wound either way: the shared RGB-D scan of a tissue box on a table
+// has 90 % of its level surface facing down, into the table. A piece is thickened against its
+// normal, so that scan's table became slabs standing up to 2 cm above it, and MuJoCo threw a mug
+// let go on the table 5 cm (Bullet, which takes the area's triangles as they are, kept it). An
+// open area (a scan) whose level faces mostly face down (more than twice the area facing up) is
+// turned over. A closed one (a table, a bin with walls) faces down underneath by right, about
+// as much as up, and is kept.
+Mesh facingUp(const Mesh& area, const Eigen::Vector3d& up) {
+  double facing_up = 0, facing_down = 0;  // faces within 45 degrees of level (twice their area)
+  for (const auto& t : area.triangles) {
+    const Eigen::Vector3d n = (area.vertices[t[1]] - area.vertices[t[0]]).cross(area.vertices[t[2]] - area.vertices[t[0]]);
+    const double c = n.dot(up), level = std::cos(M_PI / 4) * n.norm();
+    if (c > level) facing_up += n.norm();
+    if (c < -level) facing_down += n.norm();
+  }
+  if (facing_down <= 2.0 * facing_up) return area;
+  // Open: a triangle with an edge no other triangle shares (a border).
+  const std::vector<std::vector<int>> neighbours = triangleNeighbours(area);
+  const bool open = std::any_of(neighbours.begin(), neighbours.end(), [](const std::vector<int>& n) { return n.size() < 3; });
+  if (!open) return area;
+  std::vector<std::vector<int>> flipped;
+  for (const auto& t : area.triangles) flipped.push_back({t[0], t[2], t[1]});
+  return buildMesh(area.vertices, flipped, "area turned over");
+}
+
 void appendMesh(std::ostringstream& xml, const std::string& name, const std::vector<Eigen::Vector3d>& pts,
                 const Eigen::Vector3d& offset) {
   xml << "<mesh name=\"" << name << "\" vertex=\"";
@@ -161,7 +186,8 @@ MujocoValidator::MujocoValidator(const Mesh& object_O, const Mesh& area_W, const
   ac.piece_thickness = 0.02;
   ac.piece_full_depth_along = -config.gravity;  // floors and shelves: thick even where thin
   std::vector<std::vector<Eigen::Vector3d>> object_pieces = piecesOf(object_O, config, pc, loops);
-  std::vector<std::vector<Eigen::Vector3d>> area_pieces = convexPieces(subdivided(area_W, 0.5 * ac.piece_max_size), ac);
+  std::vector<std::vector<Eigen::Vector3d>> area_pieces =
+      convexPieces(subdivided(facingUp(area_W, -config.gravity.normalized()), 0.5 * ac.piece_max_size), ac);
 
   const BoxBody body = boxBody(object_O, config.density);  // as Bullet's
   const double mass = body.mass;

@@ -68,6 +68,33 @@ TEST(MujocoValidator, KeepsACubeOnAnAreaWoundFacingDown) {
   EXPECT_TRUE(table.check(Eigen::Isometry3d::Identity()).confirmed);
 }
 
+// A mesh wound inwards (a reconstruction's normals flipped) is the same body: the YCB mug
+// upright on the table, and the cube on a table wound inwards, stay in both engines as wound
+// outwards. Before the pieces were turned outwards, their slabs stood out of the mug and Bullet
+// and MuJoCo kept none of its three best poses on books_stack.
+TEST(MujocoValidator, AMeshWoundInwardsIsTheSameBody) {
+  PP_VALIDATION_REQUIRE_SHARED_DATA();
+  auto inwards = [](const Mesh& m) {
+    std::vector<std::vector<int>> polygons;
+    for (const auto& t : m.triangles) polygons.push_back({t[0], t[2], t[1]});
+    return buildMesh(m.vertices, polygons, "wound inwards");
+  };
+  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh table = scenes::table();
+  // Upright, its base on the table (the mug's frame is at its base).
+  double low = 1e300;
+  for (const Eigen::Vector3d& v : mug.vertices) low = std::min(low, v.z());
+  const Eigen::Isometry3d upright(Eigen::Translation3d(0, 0, -low));
+  for (const Mesh& object : {mug, inwards(mug)}) {
+    const PoseCheck b = PhysicsValidator(object, table, withFriction(0.2)).check(upright);
+    EXPECT_TRUE(b.confirmed) << "Bullet: moved " << b.moved_m << " m, turned " << b.turned_deg << " deg";
+    const PoseCheck m = MujocoValidator(object, table, withFriction(0.2)).check(upright);
+    EXPECT_TRUE(m.confirmed) << "MuJoCo: moved " << m.moved_m << " m, turned " << m.turned_deg << " deg";
+  }
+  const PoseCheck cube = MujocoValidator(scenes::byName("cube"), inwards(table), withFriction(0.2)).check(Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(cube.confirmed) << "the table wound inwards: moved " << cube.moved_m << " m";
+}
+
 // The friction law on a slope, both sides of tan(slope) = mu, as Bullet's test of the same.
 TEST(MujocoValidator, CubeOnASlopeSticksOrSlidesByFriction) {
   struct Case {

@@ -219,7 +219,8 @@ double remainingBudgetMs(double plan_budget_ms, double used_ms);
 // mujoco_validator.h): neighbouring triangles of similar normal (config.piece_max_normal_deg,
 // piece_max_size, piece_max_triangles) grouped, each group the point set of a slab thickened
 // inwards (against its normal) by config.piece_thickness, less where the other side is nearer,
-// and inset by the margins (config.margin: Bullet's; 0 for an engine without margins).
+// and inset by the margins (config.margin: Bullet's; 0 for an engine without margins). A closed
+// mesh wound inwards (negative signed volume) is turned outwards first.
 std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const ValidatorConfig& config);
 // A closed mesh's volume over its convex hull's (0 for an open mesh).
 double convexity(const Mesh& mesh);

@@ -98,14 +98,8 @@ Mesh facingUp(const Mesh& area, const Eigen::Vector3d& up) {
     if (c > level) facing_up += n.norm();
     if (c < -level) facing_down += n.norm();
   }
-  if (facing_down <= 2.0 * facing_up) return area;
-  // Open: a triangle with an edge no other triangle shares (a border).
-  const std::vector<std::vector<int>> neighbours = triangleNeighbours(area);
-  const bool open = std::any_of(neighbours.begin(), neighbours.end(), [](const std::vector<int>& n) { return n.size() < 3; });
-  if (!open) return area;
-  std::vector<std::vector<int>> flipped;
-  for (const auto& t : area.triangles) flipped.push_back({t[0], t[2], t[1]});
-  return buildMesh(area.vertices, flipped, "area turned over");
+  if (facing_down <= 2.0 * facing_up || closedMesh(area, false)) return area;
+  return turnedOver(area);
 }
 
 void appendMesh(std::ostringstream& xml, const std::string& name, const std::vector<Eigen::Vector3d>& pts,

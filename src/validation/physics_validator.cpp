@@ -367,29 +367,6 @@ double hullVolume(const std::vector<Eigen::Vector3d>& pts) {
 
 // Mesh volume / convex hull volume for a closed mesh (every edge in exactly two triangles);
 // 0 for an open mesh.
-// Every edge shared by exactly two triangles (`manifold`), or by two or more (a closed surface
-// with a few non-manifold edges, as the YCB mug's and plate's 1k meshes have: its volume is
-// still the divergence theorem's, whatever the origin).
-bool closedMesh(const Mesh& m, bool manifold) {
-  std::map<std::pair<int, int>, int> edge_count;
-  for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) {
-      int i = t[k], j = t[(k + 1) % 3];
-      if (i > j) std::swap(i, j);
-      ++edge_count[{i, j}];
-    }
-  for (const auto& [e, n] : edge_count)
-    if (n < 2 || (manifold && n != 2)) return false;
-  return true;
-}
-
-// Divergence theorem: positive for a closed mesh wound outwards.
-double signedVolume(const Mesh& m) {
-  double vol = 0.0;
-  for (const auto& t : m.triangles) vol += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6.0;
-  return vol;
-}
-
 double meshConvexity(const Mesh& m) {
   if (!closedMesh(m, true)) return 0.0;
   const double hull = hullVolume(m.vertices);
@@ -406,16 +383,37 @@ struct World {
 
 }  // namespace
 
+bool closedMesh(const Mesh& m, bool manifold) {
+  std::map<std::pair<int, int>, int> edge_count;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      int i = t[k], j = t[(k + 1) % 3];
+      if (i > j) std::swap(i, j);
+      ++edge_count[{i, j}];
+    }
+  for (const auto& [e, n] : edge_count)
+    if (n < 2 || (manifold && n != 2)) return false;
+  return true;
+}
+
+double signedVolume(const Mesh& m) {
+  double vol = 0.0;
+  for (const auto& t : m.triangles) vol += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6.0;
+  return vol;
+}
+
+Mesh turnedOver(const Mesh& m) {
+  std::vector<std::vector<int>> reversed;
+  for (const auto& t : m.triangles) reversed.push_back({t[0], t[2], t[1]});
+  return buildMesh(m.vertices, reversed, "mesh turned over");
+}
+
 std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const ValidatorConfig& config) {
   // A closed mesh wound inwards (its signed volume negative: a reconstruction's normals flipped)
   // is turned outwards first: its slabs, thickened against their faces' normals, stood out of
   // it. The YCB mug wound inwards, its three best poses on books_stack: Bullet and MuJoCo kept
   // none of them (all three as wound outwards).
-  if (closedMesh(mesh, false) && signedVolume(mesh) < 0) {
-    std::vector<std::vector<int>> outwards;
-    for (const auto& t : mesh.triangles) outwards.push_back({t[0], t[2], t[1]});
-    return makeConvexPieces(buildMesh(mesh.vertices, outwards, "mesh turned outwards"), config);
-  }
+  if (closedMesh(mesh, false) && signedVolume(mesh) < 0) return makeConvexPieces(turnedOver(mesh), config);
   return makeConvexPieces(mesh, config);
 }
 

@@ -24,6 +24,13 @@ Eigen::Isometry3d tiltedX(double deg, const Eigen::Vector3d& t = Eigen::Vector3d
   return X;
 }
 
+// The mesh with every triangle's winding reversed (built here, not by the validator under test).
+Mesh woundTheOtherWay(const Mesh& m) {
+  std::vector<std::vector<int>> polygons;
+  for (const auto& t : m.triangles) polygons.push_back({t[0], t[2], t[1]});
+  return buildMesh(m.vertices, polygons, "wound the other way");
+}
+
 ValidatorConfig withFriction(double mu) {
   ValidatorConfig c;
   c.friction = mu;
@@ -52,9 +59,7 @@ TEST(MujocoValidator, CubeFlatStaysAndCubeOnAnEdgeFalls) {
 // thrown 2.4 cm.
 TEST(MujocoValidator, KeepsACubeOnAnAreaWoundFacingDown) {
   const Mesh plane = scenes::plane(0.6, 0.6);
-  std::vector<std::vector<int>> down;
-  for (const auto& t : plane.triangles) down.push_back({t[0], t[2], t[1]});
-  const Mesh flipped = buildMesh(plane.vertices, down, "plane facing down");
+  const Mesh flipped = woundTheOtherWay(plane);
   ASSERT_LT(flipped.patch_normals.front().z(), -0.99);
   for (const Mesh* area : {&plane, &flipped}) {
     MujocoValidator v(scenes::byName("cube"), *area, withFriction(0.2));
@@ -74,24 +79,19 @@ TEST(MujocoValidator, KeepsACubeOnAnAreaWoundFacingDown) {
 // and MuJoCo kept none of its three best poses on books_stack.
 TEST(MujocoValidator, AMeshWoundInwardsIsTheSameBody) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  auto inwards = [](const Mesh& m) {
-    std::vector<std::vector<int>> polygons;
-    for (const auto& t : m.triangles) polygons.push_back({t[0], t[2], t[1]});
-    return buildMesh(m.vertices, polygons, "wound inwards");
-  };
   const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
   const Mesh table = scenes::table();
   // Upright, its base on the table (the mug's frame is at its base).
   double low = 1e300;
   for (const Eigen::Vector3d& v : mug.vertices) low = std::min(low, v.z());
   const Eigen::Isometry3d upright(Eigen::Translation3d(0, 0, -low));
-  for (const Mesh& object : {mug, inwards(mug)}) {
+  for (const Mesh& object : {mug, woundTheOtherWay(mug)}) {
     const PoseCheck b = PhysicsValidator(object, table, withFriction(0.2)).check(upright);
     EXPECT_TRUE(b.confirmed) << "Bullet: moved " << b.moved_m << " m, turned " << b.turned_deg << " deg";
     const PoseCheck m = MujocoValidator(object, table, withFriction(0.2)).check(upright);
     EXPECT_TRUE(m.confirmed) << "MuJoCo: moved " << m.moved_m << " m, turned " << m.turned_deg << " deg";
   }
-  const PoseCheck cube = MujocoValidator(scenes::byName("cube"), inwards(table), withFriction(0.2)).check(Eigen::Isometry3d::Identity());
+  const PoseCheck cube = MujocoValidator(scenes::byName("cube"), woundTheOtherWay(table), withFriction(0.2)).check(Eigen::Isometry3d::Identity());
   EXPECT_TRUE(cube.confirmed) << "the table wound inwards: moved " << cube.moved_m << " m";
 }
 

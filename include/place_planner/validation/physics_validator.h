@@ -222,6 +222,14 @@ double remainingBudgetMs(double plan_budget_ms, double used_ms);
 // and inset by the margins (config.margin: Bullet's; 0 for an engine without margins). A closed
 // mesh wound inwards (negative signed volume) is turned outwards first.
 std::vector<std::vector<Eigen::Vector3d>> convexPieces(const Mesh& mesh, const ValidatorConfig& config);
+// Every edge shared by exactly two triangles (`manifold`), or by two or more (a closed surface
+// with a few non-manifold edges, as the YCB mug's and plate's 1k meshes have: its volume is
+// still the divergence theorem's, whatever the origin).
+bool closedMesh(const Mesh& mesh, bool manifold);
+// Volume by the divergence theorem: positive for a closed mesh wound outwards.
+double signedVolume(const Mesh& mesh);
+// The same surface with every triangle's winding reversed (its normals flipped).
+Mesh turnedOver(const Mesh& mesh);
 // A closed mesh's volume over its convex hull's (0 for an open mesh).
 double convexity(const Mesh& mesh);
 // Moves every point of the pieces that lies outside the convex hull of `points` onto it: a

@@ -103,6 +103,31 @@ TEST(ContactForces, RingHangsOnAPegWithItsCentreOfMassBelow) {
   }
 }
 
+// A dome held from above by a ring of 12 contacts (radius 5 cm, their normals leaning 50 degrees
+// outwards from the vertical: a bowl upside down over a cup's rim). The normals meet 4.2 cm
+// below the ring: the dome turns about that point as it slides on the ring. Its centre of mass
+// below that point, it hangs there as a pendulum; above it (a shallow bowl), the forces still
+// balance, but a tilt lowers the centre of mass and it slides off the ring's side: not stable.
+// A loop on a peg, whose normals are too near parallel to meet, is judged as before (above).
+TEST(ContactForces, ADomeOverARingHangsOnlyWithItsCentreOfMassBelowWhereItsNormalsMeet) {
+  StabilityParams sp;  // mu 0.2
+  const double r = 0.05, lean = 50.0 * M_PI / 180;
+  std::vector<ContactPoint> ring;
+  for (int k = 0; k < 12; ++k) {
+    const Eigen::Vector3d out(std::cos(k * M_PI / 6), std::sin(k * M_PI / 6), 0);
+    ring.push_back({r * out, std::sin(lean) * out + std::cos(lean) * Eigen::Vector3d::UnitZ()});
+  }
+  const double meet = -r / std::tan(lean);  // -0.042
+  const Stability deep = evaluateStability(ring, Eigen::Vector3d(0, 0, meet - 0.01), sp);
+  EXPECT_TRUE(deep.hanging);
+  EXPECT_TRUE(deep.balanced);
+  EXPECT_TRUE(deep.stable) << "its centre of mass 1 cm below where the normals meet";
+  const Stability shallow = evaluateStability(ring, Eigen::Vector3d(0, 0, meet + 0.01), sp);
+  EXPECT_TRUE(shallow.hanging);
+  EXPECT_TRUE(shallow.balanced) << "the ring's forces balance gravity";
+  EXPECT_FALSE(shallow.stable) << "its centre of mass 1 cm above where the normals meet";
+}
+
 // Hung on a peg (along x) with a wall behind (at +y, facing -y) that it touches below the peg
 // (a mug at the root of a coat peg): contacts below the centre of mass that only push sideways
 // keep it hanging. Its centre of mass 5 mm off straight below the peg, away from the wall, turns

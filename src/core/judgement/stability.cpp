@@ -186,12 +186,12 @@ bool sideContact(const ContactPoint& p) {
 // Where the normals of the contacts above the centre of mass meet (least squares), when they
 // spread enough to say how high: the point a support held from above turns about as the object
 // rolls and slides on it. NaN when the normals are too near parallel to place it in height.
-Eigen::Vector3d supportPivot(const std::vector<ContactPoint>& support, const Eigen::Vector3d& com, double tol) {
+Eigen::Vector3d supportPivot(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com, double tol) {
   const Eigen::Vector3d none = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   int n = 0;
-  for (const auto& p : support) {
+  for (const auto& p : contacts) {
     if (p.p_W.z() <= com.z() + tol) continue;  // the walls it leans on below
     const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - p.n_W * p.n_W.transpose();
     A += P;
@@ -239,7 +239,6 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
   ContactForces forces = forceModel(support, com, prm);
   Eigen::VectorXd weights;  // the solve's forces: the settle below reads its residual
   r.balanced = forces.balances(-kUp, &weights);
-
   // A pendulum rests where its centre of mass is straight below its support, which contacts
   // within tol of touching locate only roughly: a centre of mass within tol, horizontally, of
   // the segments between its contacts is at rest to the model's resolution (and to the swing's,
@@ -266,7 +265,8 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
   // But a support held from above is a pendulum only when its contacts' normals meet above the
   // centre of mass (a loop on a round peg turns about the peg's axis): a dome over a ring (a
   // bowl upside down on a cup's rim) turns about its curvature's centre, below its centre of
-  // mass, and slides off the ring's side. Balanced, not at rest: the tree ends there.
+  // mass, and slides off the ring's side. Balanced, not at rest: no tilt of the tree follows
+  // that roll (the rock settle may find where it sinks).
   // (The contacts' own normals: merged into their mean above, a dome's would meet nowhere.)
   const Eigen::Vector3d pivot = supportPivot(contacts, com, prm.tol);
   const bool inverted = std::isfinite(pivot.z()) && pivot.z() < com.z() - prm.tol;
@@ -301,7 +301,7 @@ Stability hangingStability(const std::vector<ContactPoint>& contacts, const Eige
   if (holds) {
     r.failure = Failure::kNone;
   } else if (inverted) {
-    r.failure = Failure::kTip;  // no turn about a point follows a roll about a curvature's centre
+    r.failure = Failure::kTip;  // d_f left zero: no turn about a point is that roll
   } else if (!slides(r, slip)) {
     // It swings: towards its centre of mass's side, about the support.
     r.failure = Failure::kTip;

@@ -84,7 +84,7 @@ TEST(Hanging, RingOnAWallOfPegsHangsAndStays) {
 // The YCB mug on the wall of pegs: the best candidate hangs by its handle.
 TEST(Hanging, MugOnAWallOfPegsHangsByItsHandle) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const PlanResult r = Planner().plan(mug, scenes::pegWall(), twoThreads());
   EXPECT_EQ(r.stats.pegs, 6);
   expectHangsOnAPeg(mug, r);
@@ -93,7 +93,7 @@ TEST(Hanging, MugOnAWallOfPegsHangsByItsHandle) {
 // Scanned input: the same mug with 10 % of its surface punched out still hangs by its handle.
 TEST(Hanging, MugWithHolesStillHangs) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = punchHoles(loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply"), 0.10, 7);
+  const Mesh mug = punchHoles(validation_test::sharedMesh("objects/mug_ycb025_1k.ply"), 0.10, 7);
   const PlanResult r = Planner().plan(mug, scenes::pegWall(), twoThreads());
   expectHangsOnAPeg(mug, r);
 }
@@ -105,7 +105,7 @@ TEST(Hanging, MugWithHolesStillHangs) {
 // blended with the mug's, they read as a floor or lose the peg's grip, and nothing held.
 TEST(Hanging, MugHangsOnRisingPegsLeaningOnTheWall) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const Mesh wall = scenes::pegWall(10.0);
   const PlanResult r = Planner().plan(mug, wall, twoThreads());
   ASSERT_FALSE(r.candidates.empty());
@@ -169,7 +169,7 @@ void expectStillHangsInMujoco(const Mesh& object, const Mesh& area, const Candid
 // the board touched only the board, fell, and the pose had no robust rest.
 TEST(Hanging, LowPolyMugHangsOnAWallMugRackLeaningOnItsBoard) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_lowpoly.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_lowpoly.ply");
   const Mesh rack = scenes::mugRack();
   const std::optional<Candidate> best = bestHung(mug, rack);
   ASSERT_TRUE(best);
@@ -188,7 +188,7 @@ TEST(Hanging, LowPolyMugHangsOnAWallMugRackLeaningOnItsBoard) {
 // stopped against the board and the mug had no stable pose on this rack.
 TEST(Hanging, YcbMugTurnsAlongTheMugRacksBoardToARest) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const Mesh rack = scenes::mugRack();
   const std::optional<Candidate> best = bestHung(mug, rack);
   ASSERT_TRUE(best);
@@ -206,8 +206,8 @@ TEST(Hanging, YcbMugTurnsAlongTheMugRacksBoardToARest) {
 // and Bullet keeps the true mug there. Before, no start threaded it (no stable pose).
 TEST(Hanging, AMugScannedFromAboveThreadsPastTheKnobOfTheMugRacksPeg) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh scan = loadMesh(validation_test::sharedData() + "/scans/objects/mug_ycb025_upper_scan.ply");
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025.ply");
+  const Mesh scan = validation_test::sharedMesh("scans/objects/mug_ycb025_upper_scan.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025.ply");
   const Mesh rack = scenes::mugRack();
   PlannerConfig c = twoThreads();
   c.placement = PlacementKind::kHanging;
@@ -247,7 +247,7 @@ void expectLiftedOverTheTipAndHungOnTheArm(const Mesh& object, const Mesh& hooks
 // handle, its centre of mass below the arm, and Bullet keeps it there.
 TEST(Hanging, YcbMugIsLiftedOverACupHooksTipAndHangsOnItsArm) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const Mesh hooks = scenes::cupHooks();
   const std::optional<Candidate> best = bestHung(mug, hooks);
   ASSERT_TRUE(best);
@@ -324,7 +324,7 @@ Mesh wallJHooks(double r) {
 // starts: no threaded start, no stable pose.)
 TEST(Hanging, YcbMugTurnsItsHandleUprightToPassOverATallHookTip) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   std::vector<Mesh> parts{scenes::box(0.6, 0.2, 0.02, {0, 0, 0.41})};
   for (const double x : {-0.2, 0.0, 0.2}) {
     parts.push_back(rod({x, 0, 0.33}, {x, 0, 0.403}, 0.003));
@@ -346,7 +346,7 @@ TEST(Hanging, YcbMugTurnsItsHandleUprightToPassOverATallHookTip) {
 // threaded start, no stable pose.)
 TEST(Hanging, YcbMugTurnsItsBodyOutFromTheWallToPassAShortJHooksTip) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const Mesh hooks = wallJHooks(0.003);
   const std::optional<Candidate> best = bestHung(mug, hooks);
   ASSERT_TRUE(best);
@@ -509,7 +509,7 @@ TEST(Hanging, ARingSwingsAgainstAShortBoardWithoutEnteringIt) {
 // than 2 degrees slid it down to the board's lower edge, where the YCB mug found no rest.
 TEST(Hanging, MugStaysWhereThreadedOnAPegRisingUnderHalfTheFrictionAngle) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const Mesh rack = scenes::mugRack(5.0);
   const std::optional<Candidate> best = bestHung(mug, rack);
   ASSERT_TRUE(best);
@@ -605,8 +605,8 @@ TEST(Hanging, MostReleasesHoldingIsEnoughForAHangingPoseAndBulletAgrees) {
 // a larger share of held releases always ranked first.
 TEST(Hanging, AFreeHangingPoseOutranksAProppedOneThatHoldsOneMoreRelease) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh scan = loadMesh(validation_test::sharedData() + "/scans/objects/mug_ycb025_allaround_scan.ply");
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025.ply");
+  const Mesh scan = validation_test::sharedMesh("scans/objects/mug_ycb025_allaround_scan.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025.ply");
   const Mesh wall = scenes::pegWall();
   const std::optional<Candidate> best = bestHung(scan, wall);
   ASSERT_TRUE(best);
@@ -619,7 +619,7 @@ TEST(Hanging, AFreeHangingPoseOutranksAProppedOneThatHoldsOneMoreRelease) {
 // its body leaning on the post below the arm; Bullet keeps it hanging.
 TEST(Hanging, MugHangsAtTheRootOfAMugTreesRisingArm) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const std::optional<Candidate> best = bestHung(mug, scenes::mugTree());
   ASSERT_TRUE(best);
   EXPECT_EQ(best->start, StartKind::kLoopOnPeg);
@@ -648,7 +648,7 @@ TEST(Hanging, RingLeansOnTheMugTreesPostAndStaysOnItsArm) {
 // the handle's opening is bridged and Bullet pushes the mug off the peg (moved about 2 cm).
 TEST(Hanging, MugHangingOnAPegStaysInBullet) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const Mesh wall = scenes::pegWall();
   const PlanResult r = Planner().plan(mug, wall, twoThreads());
   expectHangsOnAPeg(mug, r);

@@ -28,7 +28,7 @@ TEST(MeshVariants, HolesRemoveTheRequestedFractionAndKeepTheFrame) {
 
 TEST(MeshVariants, ClusteringHitsTheTargetOnTheFullMug) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025.ply");
   for (int target : {200, 600, 1000}) {
     const Mesh d = decimateByClustering(mug, target);
     EXPECT_NEAR(double(d.triangles.size()), target, 0.1 * target) << target;

@@ -79,7 +79,7 @@ TEST(MujocoValidator, KeepsACubeOnAnAreaWoundFacingDown) {
 // and MuJoCo kept none of its three best poses on books_stack.
 TEST(MujocoValidator, AMeshWoundInwardsIsTheSameBody) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const Mesh table = scenes::table();
   // Upright, its base on the table (the mug's frame is at its base).
   double low = 1e300;
@@ -174,7 +174,7 @@ TEST(MujocoValidator, ConeOnItsBaseStaysItsSlabsInsideItsHull) {
 // normal, reached 8 mm out through the rim: stood on its rim, MuJoCo threw the mug 4 cm.
 TEST(MujocoValidator, SliversSeedNoSlabAndTheMugStandsOnItsRim) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025.ply");
   const std::vector<std::vector<Eigen::Vector3d>> pieces = mujocoObjectPieces(mug);  // the model's own
   std::vector<std::vector<Eigen::Vector3d>> inside = pieces;
   clipToHull(inside, mug.vertices);  // each point moved onto the mug's hull where outside it
@@ -197,7 +197,7 @@ TEST(MujocoValidator, SliversSeedNoSlabAndTheMugStandsOnItsRim) {
 // pose that is not stable.
 TEST(MujocoValidator, AgreesWithBulletOnTheMugsBestPoses) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
   const Mesh table = scenes::table();
   PlannerConfig pc;
   pc.max_candidates = 3;

@@ -219,8 +219,8 @@ TEST(PhysicsValidator, BadConfigNamesTheField) {
 
 TEST(PhysicsValidator, YcbMugUprightOnSharedTable) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh mug = loadMesh(validation_test::sharedData() + "/objects/mug_ycb025_1k.ply");
-  const Mesh table = loadMesh(validation_test::sharedData() + "/areas/table.ply");
+  const Mesh mug = validation_test::sharedMesh("objects/mug_ycb025_1k.ply");
+  const Mesh table = validation_test::sharedMesh("areas/table.ply");
   PhysicsValidator v(mug, table, withFriction(0.3));
   EXPECT_GT(v.convexPieces(), 50);
   // Upright: lift the mug so its lowest vertex touches z = 0.
@@ -235,8 +235,8 @@ TEST(PhysicsValidator, YcbMugUprightOnSharedTable) {
 // and rolled off all six at up to 0.3 m/s (ValidatorConfig::world_scale).
 TEST(PhysicsValidator, YcbMarkerLyingOnItsHullFacetsStaysPut) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh marker = loadMesh(validation_test::sharedData() + "/objects/marker_ycb040_1k.ply");
-  const Mesh table = loadMesh(validation_test::sharedData() + "/areas/table.ply");
+  const Mesh marker = validation_test::sharedMesh("objects/marker_ycb040_1k.ply");
+  const Mesh table = validation_test::sharedMesh("areas/table.ply");
   const auto faces = restingFaces(marker, 7.0 * M_PI / 180.0);
   ASSERT_GE(faces.size(), 6u);
   PhysicsValidator v(marker, table, withFriction(0.2));
@@ -257,9 +257,9 @@ TEST(PhysicsValidator, YcbMarkerLyingOnItsHullFacetsStaysPut) {
 // high, which a 1 cm "stays put" bar then mostly spent before anything moved.
 TEST(PhysicsValidator, ThinWalledYcbObjectsRestAtTheirHeight) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh table = loadMesh(validation_test::sharedData() + "/areas/table.ply");
+  const Mesh table = validation_test::sharedMesh("areas/table.ply");
   for (const std::string name : {"mug_ycb025", "bowl_ycb024", "plate_ycb029"}) {
-    const Mesh object = loadMesh(validation_test::sharedData() + "/objects/" + name + ".ply");
+    const Mesh object = validation_test::sharedMesh("objects/" + name + ".ply");
     PhysicsValidator v(object, table, withFriction(0.2));
     ASSERT_GT(v.convexPieces(), 1) << name << ": a compound of slabs, not one hull";
     double low = 1e9;
@@ -278,8 +278,8 @@ TEST(PhysicsValidator, ThinWalledYcbObjectsRestAtTheirHeight) {
 // them were the box rocked down across a compartment onto its walls' edges, and fell in.
 TEST(PhysicsValidator, CrackerBoxInDividedTrayBestCandidatesStayPut) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh box = loadMesh(validation_test::sharedData() + "/objects/cracker_box_ycb003_1k.ply");
-  const Mesh tray = loadMesh(validation_test::sharedData() + "/areas/divided_tray.ply");
+  const Mesh box = validation_test::sharedMesh("objects/cracker_box_ycb003_1k.ply");
+  const Mesh tray = validation_test::sharedMesh("areas/divided_tray.ply");
   const PlanResult r = Planner().plan(box, tray, PlannerConfig());
   PhysicsValidator v(box, tray, withFriction(PlannerConfig().friction));
   int checked = 0;
@@ -300,8 +300,8 @@ TEST(PhysicsValidator, CrackerBoxInDividedTrayBestCandidatesStayPut) {
 // standing on the rim) stays put.
 TEST(PhysicsValidator, BowlIsNotLaidUpsideDownOverThePenCupsRim) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh bowl = loadMesh(validation_test::sharedData() + "/objects/bowl_ycb024_1k.ply");
-  const Mesh cup = loadMesh(validation_test::sharedData() + "/areas/pen_cup_ycb065j_1k.ply");
+  const Mesh bowl = validation_test::sharedMesh("objects/bowl_ycb024_1k.ply");
+  const Mesh cup = validation_test::sharedMesh("areas/pen_cup_ycb065j_1k.ply");
   PlannerConfig config;
   config.threads = 2;
   const PlanResult r = Planner().plan(bowl, cup, config);
@@ -331,7 +331,7 @@ TEST(PhysicsValidator, BowlIsNotLaidUpsideDownOverThePenCupsRim) {
 // them down it (30-49 degrees, 5-7 mm).
 TEST(PhysicsValidator, YcbMarkerOnARampLiesAlongItsFallLineAndStays) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh marker = loadMesh(validation_test::sharedData() + "/objects/marker_ycb040_1k.ply");
+  const Mesh marker = validation_test::sharedMesh("objects/marker_ycb040_1k.ply");
   // Rising along x: its fall line runs across the marker's own long axis (y).
   const double t = 8.0 * M_PI / 180;
   const Mesh ramp = buildMesh({{-0.4, -0.4, -0.4 * std::tan(t)}, {0.4, -0.4, 0.4 * std::tan(t)},
@@ -632,8 +632,8 @@ TEST(ConvexPieces, AThinBarsTopSlabEndsAtItsUnderside) {
 // 50; doc/validation.md, "Bullet keeps the plate standing in the rack".)
 TEST(PhysicsValidator, PlateStandsInTheDishRackSlot) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh plate = loadMesh(validation_test::sharedData() + "/objects/plate_ycb029_1k.ply");
-  const Mesh rack = loadMesh(validation_test::sharedData() + "/areas/dish_rack.ply");
+  const Mesh plate = validation_test::sharedMesh("objects/plate_ycb029_1k.ply");
+  const Mesh rack = validation_test::sharedMesh("areas/dish_rack.ply");
   ValidatorConfig vc;
   vc.friction = 0.2;
   const PhysicsValidator bullet(plate, rack, vc);
@@ -668,8 +668,8 @@ TEST(PhysicsValidator, PlateStandsInTheDishRackSlot) {
 // the opposite rim, about 48 degrees from vertical, and stays there.
 TEST(PhysicsValidator, MarkerLetGoUprightInThePenCupLeansAcrossIt) {
   PP_VALIDATION_REQUIRE_SHARED_DATA();
-  const Mesh marker = loadMesh(validation_test::sharedData() + "/objects/marker_ycb040_1k.ply");
-  const Mesh cup = loadMesh(validation_test::sharedData() + "/areas/pen_cup_ycb065j_1k.ply");
+  const Mesh marker = validation_test::sharedMesh("objects/marker_ycb040_1k.ply");
+  const Mesh cup = validation_test::sharedMesh("areas/pen_cup_ycb065j_1k.ply");
   const PhysicsValidator bullet(marker, cup, withFriction(0.2));
   const Eigen::Vector3d k1 = marker.properties.k1(), c_O = marker.properties.center_of_mass;
   const double rim = cup.properties.bounds_max.z(), floor = 0.008;  // m: the inner floor's height

@@ -5,10 +5,14 @@
 
 #include <string>
 
+#include "place_planner/infra/mesh_io.h"
+
 namespace place_planner {
 namespace validation_test {
 
 inline std::string sharedData() { return PP_SHARED_DATA_DIR; }
+// A mesh of ../shared/data by its path there ("objects/bowl_ycb024_1k.ply").
+inline Mesh sharedMesh(const std::string& path) { return loadMesh(sharedData() + "/" + path); }
 inline bool haveSharedData() {
   struct stat st;
   return stat((sharedData() + "/MANIFEST.tsv").c_str(), &st) == 0;

@@ -263,6 +263,7 @@ SceneResult runScene(const ScenePair& pair, const Mesh& object_full, const Mesh&
       cc.rank = static_cast<int>(k);
       cc.quality = c.quality;
       cc.X_WO = c.X_WO;
+      cc.support = c.support;
       cc.check = validator.check(c.X_WO);
       if (c.hanging) cc.check.confirmed = stillHanging(cc.check, c.X_WO, object_full.properties.center_of_mass, vc);
       if (mujoco) {
@@ -371,7 +372,7 @@ void writeChecksCsv(const std::vector<SceneResult>& results, const std::string& 
   os << "scene,variant,rank,quality,confirmed,moved_m,turned_deg,aborted,"
         "goal_x,goal_y,goal_z,goal_qw,goal_qx,goal_qy,goal_qz,"
         "final_x,final_y,final_z,final_qw,final_qx,final_qy,final_qz,"
-        "mujoco_checked,mujoco_confirmed,mujoco_moved_m,mujoco_turned_deg\n";
+        "mujoco_checked,mujoco_confirmed,mujoco_moved_m,mujoco_turned_deg,support\n";
   for (const auto& r : results)
     for (const auto& c : r.checks) {
       os << r.pair.name << ',' << r.variant << ',' << c.rank << ',' << c.quality << ','
@@ -381,7 +382,7 @@ void writeChecksCsv(const std::vector<SceneResult>& results, const std::string& 
       os << ',';
       poseCsv(os, c.check.X_WO_final);
       os << ',' << c.mujoco_checked << ',' << c.mujoco.confirmed << ',' << c.mujoco.moved_m << ','
-         << c.mujoco.turned_deg << '\n';
+         << c.mujoco.turned_deg << ',' << toString(c.support) << '\n';
     }
   writeOutputFile(path, os.str());
 }

@@ -34,6 +34,26 @@ void report(const SceneResult& r) {
                   c.check.moved_m * 1000, c.check.turned_deg);
 }
 
+// The top-3 tally on seen surface counts only the checks the planner did not flag as resting on
+// unseen surface, among the first three (a flagged pose that falls is reported apart).
+TEST(SuiteSmoke, TopThreeOnSeenSurfaceLeavesOutFlaggedPoses) {
+  SceneResult r;
+  const SupportKind kinds[] = {SupportKind::kSeen, SupportKind::kCompleted, SupportKind::kSeen, SupportKind::kSeen};
+  const bool confirmed[] = {true, false, false, true};
+  for (int k = 0; k < 4; ++k) {
+    CandidateCheck c;
+    c.rank = k;
+    c.support = kinds[k];
+    c.check.confirmed = confirmed[k];
+    r.checks.push_back(c);
+  }
+  int all = 0, seen = 0;
+  EXPECT_EQ(r.confirmedOfTop(3, &all), 1);
+  EXPECT_EQ(all, 3);
+  EXPECT_EQ(r.confirmedSeenOfTop(3, &seen), 1);  // the fourth, seen and confirmed, is not in the top 3
+  EXPECT_EQ(seen, 2);
+}
+
 TEST(SuiteSmoke, BuiltInScenesAreConfirmed) {
   std::vector<SceneResult> rs;
   for (const auto& p : std::vector<ScenePair>{

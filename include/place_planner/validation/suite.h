@@ -62,6 +62,7 @@ struct CandidateCheck {
   int rank = 0;
   double quality = 0.0;
   Eigen::Isometry3d X_WO = Eigen::Isometry3d::Identity();
+  SupportKind support = SupportKind::kSeen;  // the planner's flag: seen, or unseen surface under it
   PoseCheck check;
   bool mujoco_checked = false;  // SuiteConfig::mujoco
   PoseCheck mujoco;
@@ -109,6 +110,17 @@ struct SceneResult {
         c += ch.check.confirmed ? 1 : 0;
       }
     *validated_top = n;
+    return c;
+  }
+  // The same among those of the first k that rest on seen surface (the planner's flag).
+  int confirmedSeenOfTop(int k, int* validated_seen) const {
+    int n = 0, v = 0, c = 0;
+    for (const auto& ch : checks)
+      if (n++ < k && ch.support == SupportKind::kSeen) {
+        ++v;
+        c += ch.check.confirmed ? 1 : 0;
+      }
+    *validated_seen = v;
     return c;
   }
   int confirmedBothOfTop(int k) const {

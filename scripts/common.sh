@@ -57,3 +57,13 @@ pp_source() {
   # shellcheck disable=SC1091
   source "${PP_WS}/devel/setup.bash"
 }
+
+# Runs ../shared/tools/scansim (simulated depth-camera scans) with the given arguments, after
+# installing the Debian packages it needs (once).
+pp_scansim() {
+  local saved=("${PP_PACKAGES[@]}")
+  PP_PACKAGES=(python3-open3d python3-numpy python3-scipy)
+  pp_install_deps
+  PP_PACKAGES=("${saved[@]}")
+  /usr/bin/python3 "${PP_ROOT}/../shared/tools/scansim/scansim.py" "$@"
+}

@@ -25,6 +25,7 @@
 #include "place_planner/search/hanging_starts.h"
 #include "place_planner/infra/parallel_for.h"
 #include "place_planner/judgement/penetration.h"
+#include "place_planner/manipulation/level_release.h"
 #include "place_planner/manipulation/placeability.h"
 #include "place_planner/judgement/ranking.h"
 #include "place_planner/judgement/robustness.h"
@@ -679,6 +680,39 @@ void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, st
   std::stable_partition(candidates.begin(), candidates.end(), [](const Candidate& c) { return c.stable; });
 }
 
+// The release pose of each stable standing candidate levelled on its support where the scan's
+// noise tilted it (manipulation/level_release.h), with its path and pre-place pose; then moved
+// out of the area where the turn took part of it in (clearingShift), or left as it was.
+void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfig& config,
+                       std::vector<Candidate>& candidates) {
+  LevelReleaseParams lp;
+  lp.band = 3.0 * config.scan_noise;  // the face within three times the noise of the plane
+  if (lp.band <= 0) return;
+  Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
+  X_GW.linear() = m.am->R_GW;
+  for (Candidate& c : candidates) {
+    // On a cap the face is the completion's guess, not the scan's (the cap's own lift, below).
+    if (c.hanging || !c.stable || c.support != SupportKind::kSeen) continue;
+    const Eigen::Isometry3d X_GO = X_GW * c.X_WO;
+    std::vector<Eigen::Vector3d> p, n;
+    for (const ContactPoint& k : c.contacts) {
+      p.push_back(X_GW * k.p_W);
+      n.push_back(X_GW.linear() * k.n_W);
+    }
+    const std::optional<Eigen::Isometry3d> turn = levelingTurn(object_O, X_GO, p, n, lp, m.am.get());
+    if (!turn) continue;
+    Rigid Y = toRigid(*turn * X_GO);
+    const std::optional<V3> out = clearingShift(m.om, *m.am, Y, kResultClearance, lp.band);
+    if (!out) continue;
+    Y.t = Y.t + *out;
+    const Eigen::Isometry3d D_W = X_GW.inverse() * toIsometry(Y) * X_GO.inverse() * X_GW;
+    c.X_WO = D_W * c.X_WO;
+    for (Eigen::Isometry3d& X : c.intermediate_poses) X = D_W * X;
+    c.placement.pre_place_W = D_W * c.placement.pre_place_W;
+    if (c.has_gripper_pose) c.X_WF = c.X_WO * config.grasp;
+  }
+}
+
 }  // namespace
 
 Planner::Planner() : cache_(std::make_shared<AreaModelCache>()) {}
@@ -737,6 +771,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // A scan's true surface may lie scan_noise beyond it: a scanned object is cleared by that too.
   clearOfTheArea(*models, config, kResultClearance + (completion.completed() ? config.scan_noise : 0.0),
                  run.result.candidates);
+  levelOnTheSupport(*models, models->searched(run.object), config, run.result.candidates);
   // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
   // released higher by the scan's noise or by how far the unseen may reach, whichever is more
   // (config.h scan_unseen_reach), with its path and pre-place pose. A hanging one is raised by

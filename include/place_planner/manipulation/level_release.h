@@ -1,0 +1,47 @@
+// The release pose of a standing candidate on a scan (beyond the paper): its support face level
+// with the area's support plane, not tilted by the scan's noise. Frame G (gravity -z), object O.
+//
+// The tree rests a scanned object on the few points of its scan that reach lowest: where a fused
+// scan rounds a bottle's bottom edge outward by 2-4 mm, on two bulges of its rim, 2.2° off level.
+// The true bottle, released so, lands on its flat bottom's edge and settles level, turning; a
+// rotationally symmetric one also spins about its axis (Bullet: 5-16° over the held-out bottle's
+// poses, against 0° released level). The support face is the object's surface that faces the
+// support plane within `band` of it (three times the scan's noise), and its least-squares plane
+// says how the true face lies better than its lowest points do.
+#pragma once
+#include <Eigen/Geometry>
+#include <optional>
+#include <vector>
+
+#include "place_planner/model/mesh.h"
+#include "place_planner/model/scene.h"
+
+namespace place_planner {
+
+struct LevelReleaseParams {
+  double band = 0.006;                  // m: the support face's depth above the support plane
+  double facing_deg = 30.0;             // its triangles face the plane within this
+  double min_tilt_deg = 0.2;            // a face already this level is left as it is
+  double max_tilt_deg = 5.0;            // a larger tilt is not the scan's noise: left as it is
+  double min_face_area = 1e-4;          // m^2 of support face, at least
+  double max_curve_deg = 15.0;          // flat: its normals' area-weighted mean at least cos of it long
+  double contact_tol = 0.003;           // m: contacts this near one plane are a planar support
+};
+
+// The turn (a rotation about the support face's centroid, frame G) that makes the least-squares
+// plane of the support face of `object_O` at X_GO parallel to the plane of `contacts_G` (their
+// least-squares plane, facing against gravity, with every contact's normal within 45 degrees of
+// it: a face resting on a plane, not a lean). None when the contacts are not such a plane, the
+// face is smaller than min_face_area or curved (max_curve_deg), or its tilt lies outside
+// [min_tilt_deg, max_tilt_deg].
+// Only where the area under the face is that plane too: under every sample of the face (up to
+// 16) an area triangle within `band` of P whose normal lies within 30 degrees of P's (a table, a
+// board; not peg tops or a rack's rails, where the pegs, not the face, set the tilt). `area_G`
+// null: not checked.
+std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
+                                              const std::vector<Eigen::Vector3d>& contacts_G,
+                                              const std::vector<Eigen::Vector3d>& normals_G,
+                                              const LevelReleaseParams& params,
+                                              const MeshModel* area_G = nullptr);
+
+}  // namespace place_planner

@@ -1,0 +1,61 @@
+// The release pose levelled on its support (manipulation/level_release.h).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "place_planner/infra/scenes.h"
+#include "place_planner/manipulation/level_release.h"
+
+namespace place_planner {
+namespace {
+
+double tiltDeg(const Eigen::Matrix3d& R) { return std::acos(std::clamp(R.col(2).z(), -1.0, 1.0)) * 180 / M_PI; }
+
+// A box resting tilted on a plane by `deg` about x, its lowest edge on z = 0, with three contacts
+// on the plane under that edge and the face's far end.
+struct TiltedBox {
+  Mesh box = scenes::box(0.08, 0.06, 0.04);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3d> contacts, normals;
+  explicit TiltedBox(double deg) {
+    X.linear() = Eigen::AngleAxisd(deg * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    double low = 1e9;
+    for (const auto& v : box.vertices) low = std::min(low, (X * v).z());
+    X.translation().z() = -low;
+    contacts = {{-0.03, -0.029, 0}, {0.03, -0.029, 0}, {0.0, 0.029, 0}};
+    normals.assign(3, Eigen::Vector3d::UnitZ());
+  }
+};
+
+TEST(LevelRelease, TurnsATiltedFaceParallelToItsSupportAboutTheFace) {
+  const TiltedBox b(2.0);
+  const auto turn = levelingTurn(b.box, b.X, b.contacts, b.normals, LevelReleaseParams());
+  ASSERT_TRUE(turn.has_value());
+  const Eigen::Isometry3d Y = *turn * b.X;
+  EXPECT_LT(tiltDeg(Y.linear()), 0.01);
+  // About the face: its middle stays where it was (within the turn's sagitta).
+  const Eigen::Vector3d middle(0, 0, -0.02);
+  EXPECT_LT((Y * middle - b.X * middle).norm(), 1e-3);
+}
+
+TEST(LevelRelease, LeavesALevelFaceALargeTiltAndALeanAsTheyAre) {
+  EXPECT_FALSE(levelingTurn(TiltedBox(0.0).box, TiltedBox(0.0).X, TiltedBox(0.0).contacts, TiltedBox(0.0).normals,
+                            LevelReleaseParams()).has_value())
+      << "level already";
+  const TiltedBox steep(8.0);
+  EXPECT_FALSE(levelingTurn(steep.box, steep.X, steep.contacts, steep.normals, LevelReleaseParams()).has_value())
+      << "8 degrees is not a scan's noise";
+  // Contacts that push sideways (a wall): not a face resting on a plane.
+  TiltedBox lean(2.0);
+  lean.normals[2] = Eigen::Vector3d(0, -1, 0.2).normalized();
+  EXPECT_FALSE(levelingTurn(lean.box, lean.X, lean.contacts, lean.normals, LevelReleaseParams()).has_value());
+  // No band (scan_noise 0): nothing is levelled.
+  LevelReleaseParams none;
+  none.band = 0;
+  const TiltedBox b(2.0);
+  EXPECT_FALSE(levelingTurn(b.box, b.X, b.contacts, b.normals, none).has_value());
+}
+
+}  // namespace
+}  // namespace place_planner

@@ -687,6 +687,7 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
                        std::vector<Candidate>& candidates) {
   LevelReleaseParams lp;
   lp.band = 3.0 * config.scan_noise;  // the face within three times the noise of the plane
+  lp.area_tol = config.scan_noise;    // the area under it that plane within the noise
   if (lp.band <= 0) return;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = m.am->R_GW;

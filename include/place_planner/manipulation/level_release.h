@@ -26,6 +26,7 @@ struct LevelReleaseParams {
   double min_face_area = 1e-4;          // m^2 of support face, at least
   double max_curve_deg = 15.0;          // flat: its normals' area-weighted mean at least cos of it long
   double contact_tol = 0.003;           // m: contacts this near one plane are a planar support
+  double area_tol = 0.002;              // m: the area under the face is that plane within this
 };
 
 // The turn (a rotation about the support face's centroid, frame G) that makes the least-squares
@@ -35,9 +36,9 @@ struct LevelReleaseParams {
 // face is smaller than min_face_area or curved (max_curve_deg), or its tilt lies outside
 // [min_tilt_deg, max_tilt_deg].
 // Only where the area under the face is that plane too: under every sample of the face (up to
-// 16) an area triangle within `band` of P whose normal lies within 30 degrees of P's (a table, a
-// board; not peg tops or a rack's rails, where the pegs, not the face, set the tilt). `area_G`
-// null: not checked.
+// 16) an area triangle within area_tol of P whose normal lies within 30 degrees of P's (a table,
+// a board; not peg tops, a rack's rails or a terrain's swell, where they, not the face, set the
+// tilt). `area_G` null: not checked.
 std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
                                               const std::vector<Eigen::Vector3d>& contacts_G,
                                               const std::vector<Eigen::Vector3d>& normals_G,

@@ -26,8 +26,9 @@ Plane fitPlane(const std::vector<Eigen::Vector3d>& p, const std::vector<double>&
 }
 
 // Under each of up to 16 of the face's samples (projected along P's normal) an area triangle
-// within `band` of P facing along P within 30 degrees (a scan's triangles tilt by its noise).
-bool flatUnder(const MeshModel& area, const std::vector<Eigen::Vector3d>& samples, const Plane& P, double band) {
+// whose corners lie within `tol` of P, facing along P within 30 degrees (a scan's triangles tilt
+// by its noise).
+bool flatUnder(const MeshModel& area, const std::vector<Eigen::Vector3d>& samples, const Plane& P, double tol) {
   const double facing = std::cos(30.0 * M_PI / 180.0);
   const Eigen::Vector3d u = P.normal.unitOrthogonal(), w = P.normal.cross(u);
   auto in2d = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - P.centroid).dot(u), (p - P.centroid).dot(w)); };
@@ -40,7 +41,9 @@ bool flatUnder(const MeshModel& area, const std::vector<Eigen::Vector3d>& sample
       const Eigen::Vector3d a = toEigen(area.vertices[tri[0]]), b = toEigen(area.vertices[tri[1]]),
                             c = toEigen(area.vertices[tri[2]]);
       if (std::abs(toEigen(area.triangle_normals[t]).dot(P.normal)) < facing) continue;
-      if (std::abs((a - P.centroid).dot(P.normal)) > band) continue;
+      if (std::abs((a - P.centroid).dot(P.normal)) > tol || std::abs((b - P.centroid).dot(P.normal)) > tol ||
+          std::abs((c - P.centroid).dot(P.normal)) > tol)
+        continue;
       const Eigen::Vector2d A = in2d(a), B = in2d(b), C = in2d(c);
       auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
         return (y - x).x() * (p - x).y() - (y - x).y() * (p - x).x();
@@ -120,7 +123,7 @@ std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen:
   if (F.normal.dot(P.normal) < 0) F.normal = -F.normal;
   const double tilt = std::acos(std::clamp(F.normal.dot(P.normal), -1.0, 1.0));
   if (tilt < params.min_tilt_deg * M_PI / 180.0 || tilt > params.max_tilt_deg * M_PI / 180.0) return std::nullopt;
-  if (area_G && !flatUnder(*area_G, pts, P, params.band)) return std::nullopt;
+  if (area_G && !flatUnder(*area_G, pts, P, params.area_tol)) return std::nullopt;
   // About the face's centroid: the face turned parallel to P, where it was.
   Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
   turn.linear() = Eigen::Quaterniond::FromTwoVectors(F.normal, P.normal).toRotationMatrix();

@@ -647,6 +647,15 @@ class TreeSearch {
   SearchMonitor monitor_;
 };
 
+// A candidate moved by D_W (frame W, applied on the left) with its path, its pre-place pose and
+// the gripper's pose.
+void moveCandidate(Candidate& c, const Eigen::Isometry3d& D_W, const PlannerConfig& config) {
+  c.X_WO = D_W * c.X_WO;
+  for (Eigen::Isometry3d& X : c.intermediate_poses) X = D_W * X;
+  c.placement.pre_place_W = D_W * c.placement.pre_place_W;
+  if (c.has_gripper_pose) c.X_WF = c.X_WO * config.grasp;
+}
+
 // A returned hanging pose moved out of the area, `gap` beyond it (penetration.h,
 // clearedPose), with its path and pre-place pose (its contacts stay where it touches, where
 // it swings back to when let go): the guard lets it lie up to a contact distance inside a wall
@@ -672,10 +681,7 @@ void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, st
     }
     // The move, applied to the pose, its path and its pre-place pose (frame W).
     const Eigen::Isometry3d D_W = X_GW.inverse() * toIsometry(*Y) * X_GO.inverse() * X_GW;
-    c.X_WO = D_W * c.X_WO;
-    for (Eigen::Isometry3d& X : c.intermediate_poses) X = D_W * X;
-    c.placement.pre_place_W = D_W * c.placement.pre_place_W;
-    if (c.has_gripper_pose) c.X_WF = c.X_WO * config.grasp;
+    moveCandidate(c, D_W, config);
   }
   std::stable_partition(candidates.begin(), candidates.end(), [](const Candidate& c) { return c.stable; });
 }
@@ -707,10 +713,7 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
     if (!out) continue;
     Y.t = Y.t + *out;
     const Eigen::Isometry3d D_W = X_GW.inverse() * toIsometry(Y) * X_GO.inverse() * X_GW;
-    c.X_WO = D_W * c.X_WO;
-    for (Eigen::Isometry3d& X : c.intermediate_poses) X = D_W * X;
-    c.placement.pre_place_W = D_W * c.placement.pre_place_W;
-    if (c.has_gripper_pose) c.X_WF = c.X_WO * config.grasp;
+    moveCandidate(c, D_W, config);
   }
 }
 
@@ -782,10 +785,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
     for (Candidate& c : run.result.candidates) {
       if (c.support != SupportKind::kCompleted) continue;
       const Eigen::Vector3d lift = -(c.hanging ? config.scan_noise : cap_lift) * config.gravity.normalized();
-      c.X_WO.pretranslate(lift);
-      for (Eigen::Isometry3d& X : c.intermediate_poses) X.pretranslate(lift);
-      c.placement.pre_place_W.pretranslate(lift);
-      if (c.has_gripper_pose) c.X_WF = c.X_WO * config.grasp;
+      moveCandidate(c, Eigen::Isometry3d(Eigen::Translation3d(lift)), config);
     }
   }
   // The first robust stable pose was found by the ranking (the search's checks were bounded).

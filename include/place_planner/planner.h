@@ -96,6 +96,10 @@ struct Candidate {
   // of what the area's scan saw). Those rank after every stable pose on seen surface.
   SupportKind support = SupportKind::kSeen;
   bool completed_support() const { return support != SupportKind::kSeen; }
+  // A scanned object resting on a curved face of its scan (a can on its side, a rounded rim:
+  // manipulation/level_release.h restsOnCurvedFace): where it comes to rest there is finer than
+  // the scan. Ranked after the stable poses on a flat face of seen surface.
+  bool curved_support = false;
   double reorientation = 0.0;      // rad, rotation from the held orientation to the goal
   // The largest horizontal push its contacts resist, in weights (judgement/contact_forces.h):
   // the smallest over 8 directions, their mean, and the weakest direction (W, horizontal).

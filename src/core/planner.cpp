@@ -717,6 +717,33 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
   }
 }
 
+// A scanned object's stable standing poses on seen surface that rest on a curved face of the
+// scan (a can or a bottle on its side, a rounded rim) marked, and ranked after those on a flat
+// face: where on a curved face the true object comes to rest is finer than the scan (Bullet
+// rolled the held-out can, planned lying on its in-hand scan, by 18 degrees), while a flat face
+// holds whatever the scan's noise (doc/method.md, "Curved supports after flat ones").
+void curvedSupportsLast(const Mesh& object_O, const Eigen::Matrix3d& R_GW, const PlannerConfig& config,
+                        std::vector<Candidate>& candidates) {
+  LevelReleaseParams lp;
+  lp.band = 3.0 * config.scan_noise;  // the support face as levelOnTheSupport takes it
+  if (lp.band <= 0) return;
+  Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
+  X_GW.linear() = R_GW;
+  for (Candidate& c : candidates) {
+    if (c.hanging || !c.stable || c.support != SupportKind::kSeen) continue;
+    std::vector<Eigen::Vector3d> p, n;
+    for (const ContactPoint& k : c.contacts) {
+      p.push_back(X_GW * k.p_W);
+      n.push_back(X_GW.linear() * k.n_W);
+    }
+    c.curved_support = restsOnCurvedFace(object_O, X_GW * c.X_WO, p, n, lp);
+  }
+  // Stable on a flat seen face; stable on a curved one; stable on unseen surface; the rest.
+  auto group = [](const Candidate& c) { return !c.stable ? 3 : c.support != SupportKind::kSeen ? 2 : c.curved_support ? 1 : 0; };
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [&](const Candidate& a, const Candidate& b) { return group(a) < group(b); });
+}
+
 }  // namespace
 
 Planner::Planner() : cache_(std::make_shared<AreaModelCache>()) {}
@@ -776,6 +803,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   clearOfTheArea(*models, config, kResultClearance + (completion.completed() ? config.scan_noise : 0.0),
                  run.result.candidates);
   levelOnTheSupport(*models, models->searched(run.object), config, run.result.candidates);
+  if (run.run_completion()) curvedSupportsLast(models->searched(run.object), models->am->R_GW, config, run.result.candidates);
   // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
   // released higher by the scan's noise or by how far the unseen may reach, whichever is more
   // (config.h scan_unseen_reach), with its path and pre-place pose. A hanging one is raised by

@@ -269,6 +269,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
         {"quality", k.quality},
         {"stable", k.stable},
         {"support", toString(k.support)},
+        {"curved_support", k.curved_support},
         {"push_resistance",
          {{"min", k.push_resistance}, {"mean", k.push_resistance_mean}, {"weakest_direction", vecJson(k.push_weakest_W)}}},
         {"start", toString(k.start)},

@@ -57,5 +57,28 @@ TEST(LevelRelease, LeavesALevelFaceALargeTiltAndALeanAsTheyAre) {
   EXPECT_FALSE(levelingTurn(b.box, b.X, b.contacts, b.normals, none).has_value());
 }
 
+// A can lying on its side rests on a curved face; standing, or a box on a face, on a flat one.
+// The contacts: four points of the table under it (z = 0).
+TEST(LevelRelease, ACanOnItsSideRestsOnACurvedFace) {
+  const Mesh can = scenes::cylinder(0.033, 0.12, 48);
+  const std::vector<Eigen::Vector3d> up(4, Eigen::Vector3d::UnitZ());
+  const LevelReleaseParams p;  // a 6 mm band: three times the default scan noise
+  Eigen::Isometry3d lying = Eigen::Isometry3d::Identity();
+  lying.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  lying.translation().z() = 0.033;
+  const std::vector<Eigen::Vector3d> line = {{-0.05, -0.004, 0}, {0.05, -0.004, 0}, {-0.05, 0.004, 0}, {0.05, 0.004, 0}};
+  EXPECT_TRUE(restsOnCurvedFace(can, lying, line, up, p));
+  Eigen::Isometry3d standing = Eigen::Isometry3d::Identity();
+  standing.translation().z() = 0.06;
+  const std::vector<Eigen::Vector3d> disc = {{-0.02, -0.02, 0}, {0.02, -0.02, 0}, {-0.02, 0.02, 0}, {0.02, 0.02, 0}};
+  EXPECT_FALSE(restsOnCurvedFace(can, standing, disc, up, p));
+  const TiltedBox box(0.0);
+  EXPECT_FALSE(restsOnCurvedFace(box.box, box.X, box.contacts, box.normals, p));
+  // Contacts that are no plane facing up (a lean on a wall) say nothing about the face.
+  std::vector<Eigen::Vector3d> wall = up;
+  wall[3] = Eigen::Vector3d(0, -1, 0.2).normalized();
+  EXPECT_FALSE(restsOnCurvedFace(can, lying, line, wall, p));
+}
+
 }  // namespace
 }  // namespace place_planner

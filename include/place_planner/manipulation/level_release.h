@@ -45,4 +45,14 @@ std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen:
                                               const LevelReleaseParams& params,
                                               const MeshModel* area_G = nullptr);
 
+// True when a standing pose rests on a curved face of the object: contacts on one plane as
+// levelingTurn takes them, and a support face whose normals add up to under cos max_curve_deg
+// of its area (the side of a can, a bottle or a rod lying down; a rounded rim). On a scan, where
+// on such a face the true object comes to rest is finer than the scan (the held-out can planned
+// lying on its in-hand scan: Bullet rolled the true can 18°), so the planner ranks these poses
+// after those on a flat face (planner.cpp).
+bool restsOnCurvedFace(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
+                       const std::vector<Eigen::Vector3d>& contacts_G,
+                       const std::vector<Eigen::Vector3d>& normals_G, const LevelReleaseParams& params);
+
 }  // namespace place_planner

@@ -58,10 +58,20 @@ bool flatUnder(const MeshModel& area, const std::vector<Eigen::Vector3d>& sample
 
 }  // namespace
 
-std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
-                                              const std::vector<Eigen::Vector3d>& contacts_G,
-                                              const std::vector<Eigen::Vector3d>& normals_G,
-                                              const LevelReleaseParams& params, const MeshModel* area_G) {
+namespace {
+
+// A standing pose's support plane P and its support face, with the face's flatness.
+struct SupportFace {
+  Plane P;
+  std::vector<Eigen::Vector3d> pts;  // samples of the face (G)
+  std::vector<double> area;          // ... their weights
+  double flatness = 0;               // |sum of area-weighted normals| / the face's area; 1: flat
+};
+
+std::optional<SupportFace> supportFace(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
+                                       const std::vector<Eigen::Vector3d>& contacts_G,
+                                       const std::vector<Eigen::Vector3d>& normals_G,
+                                       const LevelReleaseParams& params) {
   if (contacts_G.size() < 3 || params.band <= 0) return std::nullopt;
   // The support plane P: the contacts on one plane facing up, each pushing along it.
   const Plane P = [&] {
@@ -118,8 +128,20 @@ std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen:
     const auto& t = object_O.triangles[i];
     normal_sum += 0.5 * (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]);
   }
-  if (normal_sum.norm() < std::cos(params.max_curve_deg * M_PI / 180.0) * face_area) return std::nullopt;
-  Plane F = fitPlane(pts, area);
+  return SupportFace{P, pts, area, normal_sum.norm() / face_area};
+}
+
+}  // namespace
+
+std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
+                                              const std::vector<Eigen::Vector3d>& contacts_G,
+                                              const std::vector<Eigen::Vector3d>& normals_G,
+                                              const LevelReleaseParams& params, const MeshModel* area_G) {
+  const std::optional<SupportFace> sf = supportFace(object_O, X_GO, contacts_G, normals_G, params);
+  if (!sf || sf->flatness < std::cos(params.max_curve_deg * M_PI / 180.0)) return std::nullopt;
+  const Plane& P = sf->P;
+  const std::vector<Eigen::Vector3d>& pts = sf->pts;
+  Plane F = fitPlane(pts, sf->area);
   if (F.normal.dot(P.normal) < 0) F.normal = -F.normal;
   const double tilt = std::acos(std::clamp(F.normal.dot(P.normal), -1.0, 1.0));
   if (tilt < params.min_tilt_deg * M_PI / 180.0 || tilt > params.max_tilt_deg * M_PI / 180.0) return std::nullopt;
@@ -129,6 +151,13 @@ std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen:
   turn.linear() = Eigen::Quaterniond::FromTwoVectors(F.normal, P.normal).toRotationMatrix();
   turn.translation() = F.centroid - turn.linear() * F.centroid;
   return turn;
+}
+
+bool restsOnCurvedFace(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
+                       const std::vector<Eigen::Vector3d>& contacts_G,
+                       const std::vector<Eigen::Vector3d>& normals_G, const LevelReleaseParams& params) {
+  const std::optional<SupportFace> sf = supportFace(object_O, X_GO, contacts_G, normals_G, params);
+  return sf && sf->flatness < std::cos(params.max_curve_deg * M_PI / 180.0);
 }
 
 }  // namespace place_planner

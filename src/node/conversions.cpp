@@ -208,6 +208,7 @@ void toMsg(const Candidate& c, const std::string& frame_id, const std::string& g
   msg->quality = c.quality;
   msg->stable = c.stable;
   msg->support = toString(c.support);
+  msg->curved_support = c.curved_support;
   msg->push_resistance = c.push_resistance;
   msg->push_resistance_mean = c.push_resistance_mean;
   msg->push_weakest_direction.header = msg->pose.header;

@@ -16,6 +16,7 @@
 #include <optional>
 
 #include "place_planner/model/area_model_cache.h"
+#include "place_planner/infra/stable_sort.h"
 #include "place_planner/model/completion.h"
 #include "place_planner/model/despike.h"
 #include "place_planner/model/area_up.h"
@@ -740,8 +741,7 @@ void curvedSupportsLast(const Mesh& object_O, const Eigen::Matrix3d& R_GW, const
   }
   // Stable on a flat seen face; stable on a curved one; stable on unseen surface; the rest.
   auto group = [](const Candidate& c) { return !c.stable ? 3 : c.support != SupportKind::kSeen ? 2 : c.curved_support ? 1 : 0; };
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [&](const Candidate& a, const Candidate& b) { return group(a) < group(b); });
+  stableSortAligned(candidates, [&](const Candidate& a, const Candidate& b) { return group(a) < group(b); });
 }
 
 }  // namespace

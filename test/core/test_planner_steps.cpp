@@ -563,6 +563,61 @@ TEST(Penetration, AJammedRodIsClearedByATurnNoShiftGives) {
   EXPECT_EQ(rotationAngle(*same, *Y), 0.0);
 }
 
+// 50 poses of a box lying on one face (down along -z of O) at a row of floor points score Q
+// 0.9 and all fail their releases; 5 standing on another face (down along -x of O) score 0.7
+// and hold. The checks are bounded (four times max_candidates): taken in score order they went
+// to 40 lying poses and none robust was returned. While none has held, a face whose poses
+// failed is tried again only after the faces not yet tried.
+TEST(Ranking, AFaceWhosePosesFailedIsTriedAfterTheOthers) {
+  auto leafAt = [](double x, bool standing) {
+    TreeLeaf l;
+    Eigen::Isometry3d X = Eigen::Isometry3d(Eigen::Translation3d(x, 0, 0.05));
+    // Standing: O's -x points down (a quarter turn about y).
+    if (standing) X.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    l.X_GO = toRigid(X);
+    l.stable = l.supported = true;
+    l.quality = standing ? 0.7 : 0.9;
+    for (const double cx : {-0.03, 0.03})
+      for (const double cy : {-0.03, 0.03}) {
+        ContactPoint c;
+        c.p_W = Eigen::Vector3d(x + cx, cy, 0);
+        c.n_area_W = Eigen::Vector3d::UnitZ();
+        l.contacts.push_back(c);
+      }
+    return l;
+  };
+  std::vector<TreeLeaf> leaves;
+  std::vector<StartKind> kinds;
+  std::vector<Eigen::Vector3d> fps;
+  for (int i = 0; i < 55; ++i) {
+    const bool standing = i >= 50;
+    leaves.push_back(leafAt(0.1 * i, standing));
+    kinds.push_back(StartKind::kRestingFace);
+    fps.push_back(Eigen::Vector3d(0.1 * i, 0, 0));
+  }
+  RankingInput in{leaves, kinds, fps, Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(), 0.087};
+  int checked = 0;
+  const RobustnessCheck check = [&](const std::vector<size_t>& idx) {
+    std::vector<Robustness> out;
+    for (const size_t i : idx) out.push_back(Robustness{12, i >= 50 ? 12 : 3, 0.2});
+    checked += static_cast<int>(idx.size());
+    return out;
+  };
+  PlannerConfig config;  // max_candidates 10
+  PlanStats stats;
+  const std::vector<Candidate> c = rankCandidates(in, config, check, &stats);
+  ASSERT_FALSE(c.empty());
+  ASSERT_TRUE(c.front().stable) << "the standing poses were never checked";
+  int standing = 0;
+  for (const Candidate& k : c)
+    if (k.stable) {
+      EXPECT_GT(k.X_WO.translation().x(), 4.95) << "a lying pose returned stable";
+      ++standing;
+    }
+  EXPECT_EQ(standing, 5);
+  EXPECT_LE(checked, 4 * config.max_candidates) << "the checks' bound";
+}
+
 TEST(Ranking, TheLargerTippingMarginRanksFirstAmongEqualPoses) {
   // Two stable poses of a 10 cm cube on a flat top, alike in Q, contacts and robust share; one
   // tips off after 2 degrees of tilt, the other after 8. The tie-break alone (nearer the frame's

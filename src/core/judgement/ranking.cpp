@@ -37,6 +37,9 @@ constexpr double kUnstableShareWeight = 0.05;
 // peg in Bullet (hanging suite, best 36/40 -> 37/40, top-3 105 -> 106/111); a 10 degree cap
 // also reorders lying bottles whose margins differ at 3-10 degrees (scan suite top-3 145 -> 144).
 constexpr double kTipWeight = 0.05, kTipFull = 5.0 * M_PI / 180.0;
+// Leaves whose down directions (in O) lie within this rest on the same face (ranking's
+// robustness order).
+constexpr double kSameFaceDeg = 15.0;
 // Intermediate poses closer than this to the one before are merged into it (m, rad).
 constexpr double kPathStep = 0.002, kPathTurn = 2.0 * M_PI / 180.0;
 
@@ -163,15 +166,41 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
       return it.stable;
     };
     int robust = 0, checked = 0;
-    size_t next = 0;
+    // Which way is down in the object (O) at a leaf: the face it rests on, whatever its yaw and
+    // place. While no pose has held, a face whose poses failed their releases is tried again only
+    // after the faces not yet tried (on seen surface before unseen, as ranked): a bottle laid on
+    // its side fails at every floor point of a table alike, and the bounded checks below went to
+    // 40 such poses while 36 robust ones standing upright ranked after them (a held-out bottle's
+    // scan, seed 1). Once one holds, the checks go on in rank order (deferring failing faces
+    // then let lower-ranked faces fill max_candidates: a sugar box in the rack lost a confirmed
+    // pose of its top 5).
+    auto down = [&](const Item& it) { return rotateInv(leaves[it.leaf].X_GO, v3(0, 0, -1)); };
+    std::vector<V3> failed_down;
+    const double same_face = std::cos(kSameFaceDeg * M_PI / 180.0);
+    auto failing = [&](const Item& it) {
+      const V3 d = down(it);
+      return robust == 0 &&
+             std::any_of(failed_down.begin(), failed_down.end(), [&](const V3& f) { return dot(d, f) > same_face; });
+    };
+    std::vector<bool> tried(distinct.size(), false);
     // Bounded work: at most four times max_candidates leaves are checked.
     while (robust < config.max_candidates && checked < 4L * config.max_candidates) {
+      // The best stable leaves not tried yet: on seen surface first, then not on a failing face.
+      std::vector<std::pair<int, size_t>> order;  // (2 * unseen + failing, rank)
+      for (size_t k = 0; k < distinct.size(); ++k)
+        if (!tried[k] && distinct[k].stable)
+          order.emplace_back(2 * (distinct[k].support != SupportKind::kSeen) + failing(distinct[k]), k);
+      std::stable_sort(order.begin(), order.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
       std::vector<size_t> batch, where;
-      for (; next < distinct.size() && batch.size() < static_cast<size_t>(config.max_candidates - robust); ++next)
-        if (distinct[next].stable && placeable(distinct[next])) {
-          batch.push_back(distinct[next].leaf);
-          where.push_back(next);
+      for (const auto& [group, k] : order) {
+        if (batch.size() >= static_cast<size_t>(config.max_candidates - robust)) break;
+        tried[k] = true;
+        if (placeable(distinct[k])) {
+          batch.push_back(distinct[k].leaf);
+          where.push_back(k);
         }
+      }
       if (batch.empty()) break;
       const std::vector<Robustness> rs = check(batch);
       checked += static_cast<int>(batch.size());
@@ -183,6 +212,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
           stats->robustness_rejected += !ok;
         }
         robust += ok;
+        if (!ok) failed_down.push_back(down(it));
       }
     }
     // Cut by a cancel or the budget, the checks above may end before the leaves the search found

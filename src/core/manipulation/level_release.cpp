@@ -56,10 +56,6 @@ bool flatUnder(const MeshModel& area, const std::vector<Eigen::Vector3d>& sample
   return true;
 }
 
-}  // namespace
-
-namespace {
-
 // A standing pose's support plane P and its support face, with the face's flatness.
 struct SupportFace {
   Plane P;

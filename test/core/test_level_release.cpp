@@ -6,6 +6,7 @@
 
 #include "place_planner/infra/scenes.h"
 #include "place_planner/manipulation/level_release.h"
+#include "place_planner/model/scene.h"
 
 namespace place_planner {
 namespace {
@@ -55,6 +56,32 @@ TEST(LevelRelease, LeavesALevelFaceALargeTiltAndALeanAsTheyAre) {
   none.band = 0;
   const TiltedBox b(2.0);
   EXPECT_FALSE(levelingTurn(b.box, b.X, b.contacts, b.normals, none).has_value());
+}
+
+// The area under the face: a board whose scan ends short of the face's far side is still the
+// plane there (past the scan's last row nothing says otherwise); a board with a step 1 cm down
+// under part of the face is not, nor is a board under only half of it. The face: the bottom of
+// a can (radius 4 cm) tilted 2 degrees, sampled at its 46 triangles' centroids.
+TEST(LevelRelease, LevelsUpToTheScansEdgeNotOverAStep) {
+  const Mesh can = scenes::cylinder(0.04, 0.1, 48);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  double low = 1e9;
+  for (const auto& v : can.vertices) low = std::min(low, (X * v).z());
+  X.translation().z() = -low;
+  const std::vector<Eigen::Vector3d> contacts = {{-0.03, -0.03, 0}, {0.03, -0.03, 0}, {0.0, 0.035, 0}};
+  const std::vector<Eigen::Vector3d> up(3, Eigen::Vector3d::UnitZ());
+  auto board = [](double x0, double x1, double z) {
+    return scenes::box(x1 - x0, 0.3, 0.01, Eigen::Vector3d(0.5 * (x0 + x1), 0, z - 0.005));
+  };
+  auto levelled = [&](const Mesh& area) {
+    const AreaModel am = buildAreaModel(area, Eigen::Vector3d(0, 0, -1), 0.001, 0.002, 0.002);
+    return levelingTurn(can, X, contacts, up, LevelReleaseParams(), &am).has_value();
+  };
+  EXPECT_TRUE(levelled(board(-0.2, 0.2, 0.0))) << "a whole board";
+  EXPECT_TRUE(levelled(board(-0.2, 0.035, 0.0))) << "the scan ends 5 mm short of the face's far side";
+  EXPECT_FALSE(levelled(board(-0.2, 0.0, 0.0))) << "half the face over nothing";
+  EXPECT_FALSE(levelled(scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.01)}))) << "a step";
 }
 
 // A can lying on its side rests on a curved face; standing, or a box on a face, on a flat one.

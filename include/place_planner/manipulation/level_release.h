@@ -35,10 +35,11 @@ struct LevelReleaseParams {
 // it: a face resting on a plane, not a lean). None when the contacts are not such a plane, the
 // face is smaller than min_face_area or curved (max_curve_deg), or its tilt lies outside
 // [min_tilt_deg, max_tilt_deg].
-// Only where the area under the face is that plane too: under every sample of the face (up to
-// 16) an area triangle within area_tol of P whose normal lies within 30 degrees of P's (a table,
-// a board; not peg tops, a rack's rails or a terrain's swell, where they, not the face, set the
-// tilt). `area_G` null: not checked.
+// Only where the area under the face is that plane too: under each sample of the face (up to
+// 16) that lies over area triangles facing along P within 60 degrees, one with its corners
+// within area_tol of P, and at least three in four samples so (a table, a board, up to a scan's
+// ragged edge; not peg tops, a rack's rails or a terrain's swell, where they, not the face, set
+// the tilt). `area_G` null: not checked.
 std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
                                               const std::vector<Eigen::Vector3d>& contacts_G,
                                               const std::vector<Eigen::Vector3d>& normals_G,

@@ -563,6 +563,27 @@ TEST(Penetration, AJammedRodIsClearedByATurnNoShiftGives) {
   EXPECT_EQ(rotationAngle(*same, *Y), 0.0);
 }
 
+namespace {
+
+// A stable leaf at X_GO (G = W) scoring `quality`, on four contacts on z = 0 at +-half of its
+// position along x and y.
+TreeLeaf stableLeafOnFourContacts(const Eigen::Isometry3d& X_GO, double half, double quality) {
+  TreeLeaf l;
+  l.X_GO = toRigid(X_GO);
+  l.stable = l.supported = true;
+  l.quality = quality;
+  for (const double cx : {-half, half})
+    for (const double cy : {-half, half}) {
+      ContactPoint c;
+      c.p_W = Eigen::Vector3d(X_GO.translation().x() + cx, X_GO.translation().y() + cy, 0);
+      c.n_area_W = Eigen::Vector3d::UnitZ();
+      l.contacts.push_back(c);
+    }
+  return l;
+}
+
+}  // namespace
+
 // 50 poses of a box lying on one face (down along -z of O) at a row of floor points score Q
 // 0.9 and all fail their releases; 5 standing on another face (down along -x of O) score 0.7
 // and hold. The checks are bounded (four times max_candidates): taken in score order they went
@@ -570,21 +591,10 @@ TEST(Penetration, AJammedRodIsClearedByATurnNoShiftGives) {
 // failed is tried again only after the faces not yet tried.
 TEST(Ranking, AFaceWhosePosesFailedIsTriedAfterTheOthers) {
   auto leafAt = [](double x, bool standing) {
-    TreeLeaf l;
     Eigen::Isometry3d X = Eigen::Isometry3d(Eigen::Translation3d(x, 0, 0.05));
     // Standing: O's -x points down (a quarter turn about y).
     if (standing) X.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    l.X_GO = toRigid(X);
-    l.stable = l.supported = true;
-    l.quality = standing ? 0.7 : 0.9;
-    for (const double cx : {-0.03, 0.03})
-      for (const double cy : {-0.03, 0.03}) {
-        ContactPoint c;
-        c.p_W = Eigen::Vector3d(x + cx, cy, 0);
-        c.n_area_W = Eigen::Vector3d::UnitZ();
-        l.contacts.push_back(c);
-      }
-    return l;
+    return stableLeafOnFourContacts(X, 0.03, standing ? 0.7 : 0.9);
   };
   std::vector<TreeLeaf> leaves;
   std::vector<StartKind> kinds;
@@ -623,18 +633,7 @@ TEST(Ranking, TheLargerTippingMarginRanksFirstAmongEqualPoses) {
   // tips off after 2 degrees of tilt, the other after 8. The tie-break alone (nearer the frame's
   // axis first) would put the 2-degree one first.
   auto leafAt = [](double x) {
-    TreeLeaf l;
-    l.X_GO = toRigid(Eigen::Isometry3d(Eigen::Translation3d(x, 0, 0.05)));
-    l.stable = l.supported = true;
-    l.quality = 0.8;
-    for (const double cx : {-0.05, 0.05})
-      for (const double cy : {-0.05, 0.05}) {
-        ContactPoint c;
-        c.p_W = Eigen::Vector3d(x + cx, cy, 0);
-        c.n_area_W = Eigen::Vector3d::UnitZ();
-        l.contacts.push_back(c);
-      }
-    return l;
+    return stableLeafOnFourContacts(Eigen::Isometry3d(Eigen::Translation3d(x, 0, 0.05)), 0.05, 0.8);
   };
   const std::vector<TreeLeaf> leaves{leafAt(0.0), leafAt(0.4)};
   const std::vector<StartKind> kinds{StartKind::kPrincipalAxis, StartKind::kPrincipalAxis};

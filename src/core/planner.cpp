@@ -15,8 +15,8 @@
 #include <mutex>
 #include <optional>
 
-#include "place_planner/model/area_model_cache.h"
 #include "place_planner/infra/stable_sort.h"
+#include "place_planner/model/area_model_cache.h"
 #include "place_planner/model/completion.h"
 #include "place_planner/model/despike.h"
 #include "place_planner/model/area_up.h"
@@ -687,26 +687,41 @@ void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, st
   std::stable_partition(candidates.begin(), candidates.end(), [](const Candidate& c) { return c.stable; });
 }
 
+// The levelling's parameters: the support face within three times the scan's noise of the
+// contacts' plane, the area under it that plane within the noise.
+LevelReleaseParams levelParams(const PlannerConfig& config) {
+  LevelReleaseParams lp;
+  lp.band = 3.0 * config.scan_noise;
+  lp.area_tol = config.scan_noise;
+  return lp;
+}
+
+// A candidate's contact points and normals in the gravity frame G.
+void contactsInG(const Candidate& c, const Eigen::Isometry3d& X_GW, std::vector<Eigen::Vector3d>& p,
+                 std::vector<Eigen::Vector3d>& n) {
+  p.clear();
+  n.clear();
+  for (const ContactPoint& k : c.contacts) {
+    p.push_back(X_GW * k.p_W);
+    n.push_back(X_GW.linear() * k.n_W);
+  }
+}
+
 // The release pose of each stable standing candidate levelled on its support where the scan's
 // noise tilted it (manipulation/level_release.h), with its path and pre-place pose; then moved
 // out of the area where the turn took part of it in (clearingShift), or left as it was.
 void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfig& config,
                        std::vector<Candidate>& candidates) {
-  LevelReleaseParams lp;
-  lp.band = 3.0 * config.scan_noise;  // the face within three times the noise of the plane
-  lp.area_tol = config.scan_noise;    // the area under it that plane within the noise
+  const LevelReleaseParams lp = levelParams(config);
   if (lp.band <= 0) return;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = m.am->R_GW;
+  std::vector<Eigen::Vector3d> p, n;
   for (Candidate& c : candidates) {
     // On a cap the face is the completion's guess, not the scan's (the cap's own lift, below).
     if (c.hanging || !c.stable || c.support != SupportKind::kSeen) continue;
     const Eigen::Isometry3d X_GO = X_GW * c.X_WO;
-    std::vector<Eigen::Vector3d> p, n;
-    for (const ContactPoint& k : c.contacts) {
-      p.push_back(X_GW * k.p_W);
-      n.push_back(X_GW.linear() * k.n_W);
-    }
+    contactsInG(c, X_GW, p, n);
     const std::optional<Eigen::Isometry3d> turn = levelingTurn(object_O, X_GO, p, n, lp, m.am.get());
     if (!turn) continue;
     Rigid Y = toRigid(*turn * X_GO);
@@ -725,18 +740,14 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
 // holds whatever the scan's noise (doc/method.md, "Curved supports after flat ones").
 void curvedSupportsLast(const Mesh& object_O, const Eigen::Matrix3d& R_GW, const PlannerConfig& config,
                         std::vector<Candidate>& candidates) {
-  LevelReleaseParams lp;
-  lp.band = 3.0 * config.scan_noise;  // the support face as levelOnTheSupport takes it
+  const LevelReleaseParams lp = levelParams(config);  // the support face as levelOnTheSupport takes it
   if (lp.band <= 0) return;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = R_GW;
+  std::vector<Eigen::Vector3d> p, n;
   for (Candidate& c : candidates) {
     if (c.hanging || !c.stable || c.support != SupportKind::kSeen) continue;
-    std::vector<Eigen::Vector3d> p, n;
-    for (const ContactPoint& k : c.contacts) {
-      p.push_back(X_GW * k.p_W);
-      n.push_back(X_GW.linear() * k.n_W);
-    }
+    contactsInG(c, X_GW, p, n);
     c.curved_support = restsOnCurvedFace(object_O, X_GW * c.X_WO, p, n, lp);
   }
   // Stable on a flat seen face; stable on a curved one; stable on unseen surface; the rest.

@@ -688,11 +688,15 @@ void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, st
 }
 
 // The levelling's parameters: the support face within three times the scan's noise of the
-// contacts' plane, the area under it that plane within the noise.
-LevelReleaseParams levelParams(const PlannerConfig& config) {
+// contacts' plane, the area under it that plane within the noise. A curved support is levelled
+// on a scan only (an open mesh): on the exact meshes a curved rest is tilted from its strip's
+// plane by the shape itself (the marker's cap: 1.3-3 degrees), and levelled there Bullet turned
+// the 1k marker 19 degrees in the divided tray.
+LevelReleaseParams levelParams(const PlannerConfig& config, bool scanned) {
   LevelReleaseParams lp;
   lp.band = 3.0 * config.scan_noise;
   lp.area_tol = config.scan_noise;
+  lp.curved = scanned;
   return lp;
 }
 
@@ -710,9 +714,9 @@ void contactsInG(const Candidate& c, const Eigen::Isometry3d& X_GW, std::vector<
 // The release pose of each stable standing candidate levelled on its support where the scan's
 // noise tilted it (manipulation/level_release.h), with its path and pre-place pose; then moved
 // out of the area where the turn took part of it in (clearingShift), or left as it was.
-void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfig& config,
+void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfig& config, bool scanned,
                        std::vector<Candidate>& candidates) {
-  const LevelReleaseParams lp = levelParams(config);
+  const LevelReleaseParams lp = levelParams(config, scanned);
   if (lp.band <= 0) return;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = m.am->R_GW;
@@ -740,7 +744,7 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
 // holds whatever the scan's noise (doc/method.md, "Curved supports after flat ones").
 void curvedSupportsLast(const Mesh& object_O, const Eigen::Matrix3d& R_GW, const PlannerConfig& config,
                         std::vector<Candidate>& candidates) {
-  const LevelReleaseParams lp = levelParams(config);  // the support face as levelOnTheSupport takes it
+  const LevelReleaseParams lp = levelParams(config, true);  // the support face as levelOnTheSupport takes it
   if (lp.band <= 0) return;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = R_GW;
@@ -813,7 +817,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // A scan's true surface may lie scan_noise beyond it: a scanned object is cleared by that too.
   clearOfTheArea(*models, config, kResultClearance + (completion.completed() ? config.scan_noise : 0.0),
                  run.result.candidates);
-  levelOnTheSupport(*models, models->searched(run.object), config, run.result.candidates);
+  levelOnTheSupport(*models, models->searched(run.object), config, run.run_completion(), run.result.candidates);
   if (run.run_completion()) curvedSupportsLast(models->searched(run.object), models->am->R_GW, config, run.result.candidates);
   // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
   // released higher by the scan's noise or by how far the unseen may reach, whichever is more

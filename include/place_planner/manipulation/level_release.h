@@ -7,7 +7,10 @@
 // rotationally symmetric one also spins about its axis (Bullet: 5-16° over the held-out bottle's
 // poses, against 0° released level). The support face is the object's surface that faces the
 // support plane within `band` of it (three times the scan's noise), and its least-squares plane
-// says how the true face lies better than its lowest points do.
+// says how the true face lies better than its lowest points do. On a curved support too: a
+// curved tube lying (a banana) rests on its arc, and its strip's plane is the arc's, where the
+// lowest points of a scan set the roll about the chord a few degrees wrong; a straight rod's
+// strip is symmetric about its lowest line whatever the roll, so it is only levelled along it.
 #pragma once
 #include <Eigen/Geometry>
 #include <optional>
@@ -25,6 +28,7 @@ struct LevelReleaseParams {
   double max_tilt_deg = 5.0;            // a larger tilt is not the scan's noise: left as it is
   double min_face_area = 1e-4;          // m^2 of support face, at least
   double max_curve_deg = 15.0;          // flat: its normals' area-weighted mean at least cos of it long
+  bool curved = true;                   // curved faces levelled too (a scan's; off: flat ones only)
   double contact_tol = 0.003;           // m: contacts this near one plane are a planar support
   double area_tol = 0.002;              // m: the area under the face is that plane within this
 };
@@ -33,8 +37,9 @@ struct LevelReleaseParams {
 // plane of the support face of `object_O` at X_GO parallel to the plane of `contacts_G` (their
 // least-squares plane, facing against gravity, with every contact's normal within 45 degrees of
 // it: a face resting on a plane, not a lean). None when the contacts are not such a plane, the
-// face is smaller than min_face_area or curved (max_curve_deg), or its tilt lies outside
-// [min_tilt_deg, max_tilt_deg].
+// face is smaller than min_face_area, or curved (max_curve_deg) with `curved` off, or its tilt
+// lies outside [min_tilt_deg, max_tilt_deg]. A curved face is cut again by its own plane until
+// the cut holds still.
 // Only where the area under the face is that plane too: under each sample of the face (up to
 // 16) that lies over area triangles facing along P within 60 degrees, one with its corners
 // within area_tol of P, and at least three in four samples so (a table, a board, up to a scan's

@@ -40,24 +40,31 @@ bool flatUnder(const MeshModel& area, const std::vector<Eigen::Vector3d>& sample
     return (y - x).x() * (p - x).y() - (y - x).y() * (p - x).x();
   };
   const size_t step = std::max<size_t>(1, samples.size() / 16);
+  // The triangles under a sample: those the line through it along P's normal meets (the area's
+  // triangle BVH along a segment across the whole area, every hit visited).
+  const Eigen::Vector3d lo = toEigen(area.bounds.lo), hi = toEigen(area.bounds.hi);
   int on_plane = 0, sampled = 0;
   for (size_t s = 0; s < samples.size(); s += step) {
     ++sampled;
     const Eigen::Vector2d q = in2d(samples[s]);
+    const double reach = (hi - lo).norm() + (samples[s] - 0.5 * (lo + hi)).norm();
+    const Eigen::Vector3d o = samples[s] + reach * P.normal;
     bool seen = false, under = false;
-    for (size_t t = 0; t < area.triangles.size() && !under; ++t) {
+    bvhRay(view(area.triangle_bvh), toV3(o), toV3(-P.normal), 2.0 * reach, [&](int t) {
+      if (under) return 0.0;  // decided: nothing more to visit
       const auto& tri = area.triangles[t];
       const Eigen::Vector3d a = toEigen(area.vertices[tri[0]]), b = toEigen(area.vertices[tri[1]]),
                             c = toEigen(area.vertices[tri[2]]);
       const double along = std::abs(toEigen(area.triangle_normals[t]).dot(P.normal));
-      if (along < kSteep) continue;  // a wall or an edge's side: nothing rests on it
+      if (along < kSteep) return 2.0 * reach;  // a wall or an edge's side: nothing rests on it
       const Eigen::Vector2d A = in2d(a), B = in2d(b), C = in2d(c);
       const double d0 = side(q, A, B), d1 = side(q, B, C), d2 = side(q, C, A);
-      if (!((d0 >= 0 && d1 >= 0 && d2 >= 0) || (d0 <= 0 && d1 <= 0 && d2 <= 0))) continue;
+      if (!((d0 >= 0 && d1 >= 0 && d2 >= 0) || (d0 <= 0 && d1 <= 0 && d2 <= 0))) return 2.0 * reach;
       seen = true;
       under = std::abs((a - P.centroid).dot(P.normal)) <= tol && std::abs((b - P.centroid).dot(P.normal)) <= tol &&
               std::abs((c - P.centroid).dot(P.normal)) <= tol;
-    }
+      return under ? 0.0 : 2.0 * reach;
+    });
     if (seen && !under) return false;
     on_plane += under;
   }
@@ -69,8 +76,56 @@ struct SupportFace {
   Plane P;
   std::vector<Eigen::Vector3d> pts;  // samples of the face (G)
   std::vector<double> area;          // ... their weights
+  double face_area = 0;              // m^2
   double flatness = 0;               // |sum of area-weighted normals| / the face's area; 1: flat
 };
+
+// The face of the object (vertices `v`, frame G) cut by a plane of normal `up`: its triangles
+// facing against `up` (within facing_deg) within `band` of its lowest point along `up`, sampled
+// at their centroids, weighted by area (a face of under three triangles, a coarse mesh's flat
+// face, at its corners).
+SupportFace faceAbove(const Mesh& object_O, const std::vector<Eigen::Vector3d>& v, const Eigen::Vector3d& up,
+                      const LevelReleaseParams& params) {
+  double lowest = 1e300;
+  for (const Eigen::Vector3d& p : v) lowest = std::min(lowest, p.dot(up));
+  const double facing = std::cos(params.facing_deg * M_PI / 180.0);
+  std::vector<size_t> face;
+  for (size_t i = 0; i < object_O.triangles.size(); ++i) {
+    const auto& t = object_O.triangles[i];
+    const Eigen::Vector3d a = v[t[0]], b = v[t[1]], c = v[t[2]];
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() <= 0 || n.normalized().dot(-up) < facing) continue;
+    if (((a + b + c) / 3.0).dot(up) - lowest > params.band) continue;
+    face.push_back(i);
+  }
+  SupportFace f;
+  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+  for (size_t i : face) {
+    const auto& t = object_O.triangles[i];
+    const Eigen::Vector3d a = v[t[0]], b = v[t[1]], c = v[t[2]];
+    const Eigen::Vector3d n2 = (b - a).cross(c - a);
+    const double A = 0.5 * n2.norm();
+    f.face_area += A;
+    normal_sum += 0.5 * n2;
+    if (face.size() >= 3) {
+      f.pts.push_back((a + b + c) / 3.0);
+      f.area.push_back(A);
+    } else {
+      for (const Eigen::Vector3d& p : {a, b, c}) f.pts.push_back(p), f.area.push_back(A / 3);
+    }
+  }
+  // A flat face: its triangles' normals, weighed by area, add up to at least cos 15 degrees of
+  // their area (a lying rod's strip is curved: 0.96 for the marker's scan; a bottle's bulged
+  // bottom 0.98).
+  f.flatness = f.face_area > 0 ? normal_sum.norm() / f.face_area : 0;
+  return f;
+}
+
+std::vector<Eigen::Vector3d> inG(const Mesh& object_O, const Eigen::Isometry3d& X_GO) {
+  std::vector<Eigen::Vector3d> v(object_O.vertices.size());
+  for (size_t i = 0; i < v.size(); ++i) v[i] = X_GO * object_O.vertices[i];
+  return v;
+}
 
 std::optional<SupportFace> supportFace(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
                                        const std::vector<Eigen::Vector3d>& contacts_G,
@@ -88,51 +143,11 @@ std::optional<SupportFace> supportFace(const Mesh& object_O, const Eigen::Isomet
     if (std::abs((contacts_G[i] - P.centroid).dot(P.normal)) > params.contact_tol) return std::nullopt;
     if (i < normals_G.size() && normals_G[i].dot(P.normal) < std::cos(M_PI / 4)) return std::nullopt;
   }
-  // The support face: triangles facing P, within `band` of the object's lowest point over P,
-  // sampled at their centroids, weighted by area.
-  double lowest = 1e300;
-  std::vector<Eigen::Vector3d> v(object_O.vertices.size());
-  for (size_t i = 0; i < v.size(); ++i) {
-    v[i] = X_GO * object_O.vertices[i];
-    lowest = std::min(lowest, (v[i] - P.centroid).dot(P.normal));
-  }
-  const double facing = std::cos(params.facing_deg * M_PI / 180.0);
-  std::vector<size_t> face;
-  for (size_t i = 0; i < object_O.triangles.size(); ++i) {
-    const auto& t = object_O.triangles[i];
-    const Eigen::Vector3d a = v[t[0]], b = v[t[1]], c = v[t[2]];
-    const Eigen::Vector3d n = (b - a).cross(c - a);
-    if (n.norm() <= 0 || n.normalized().dot(-P.normal) < facing) continue;
-    if (((a + b + c) / 3.0 - P.centroid).dot(P.normal) - lowest > params.band) continue;
-    face.push_back(i);
-  }
-  std::vector<Eigen::Vector3d> pts;
-  std::vector<double> area;
-  double face_area = 0;
-  // Each triangle at its centroid, by its area; a face of under three triangles (a coarse
-  // mesh's flat face) at its corners.
-  for (size_t i : face) {
-    const auto& t = object_O.triangles[i];
-    const Eigen::Vector3d a = v[t[0]], b = v[t[1]], c = v[t[2]];
-    const double A = 0.5 * (b - a).cross(c - a).norm();
-    face_area += A;
-    if (face.size() >= 3) {
-      pts.push_back((a + b + c) / 3.0);
-      area.push_back(A);
-    } else {
-      for (const Eigen::Vector3d& p : {a, b, c}) pts.push_back(p), area.push_back(A / 3);
-    }
-  }
-  if (pts.size() < 3 || face_area < params.min_face_area) return std::nullopt;
-  // A flat face: its triangles' normals, weighed by area, add up to at least cos 15 degrees of
-  // their area (a lying rod's strip is curved: 0.96 for the marker's scan; a bottle's bulged
-  // bottom 0.98). On a curved face the turn would be a roll.
-  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
-  for (size_t i : face) {
-    const auto& t = object_O.triangles[i];
-    normal_sum += 0.5 * (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]);
-  }
-  return SupportFace{P, pts, area, normal_sum.norm() / face_area};
+  // The support face: the object's surface facing P within `band` of its lowest point over P.
+  SupportFace f = faceAbove(object_O, inG(object_O, X_GO), P.normal, params);
+  if (f.pts.size() < 3 || f.face_area < params.min_face_area) return std::nullopt;
+  f.P = P;
+  return f;
 }
 
 }  // namespace
@@ -142,11 +157,27 @@ std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen:
                                               const std::vector<Eigen::Vector3d>& normals_G,
                                               const LevelReleaseParams& params, const MeshModel* area_G) {
   const std::optional<SupportFace> sf = supportFace(object_O, X_GO, contacts_G, normals_G, params);
-  if (!sf || sf->flatness < std::cos(params.max_curve_deg * M_PI / 180.0)) return std::nullopt;
+  const bool curved = sf && sf->flatness < std::cos(params.max_curve_deg * M_PI / 180.0);
+  if (!sf || (curved && !params.curved)) return std::nullopt;
   const Plane& P = sf->P;
-  const std::vector<Eigen::Vector3d>& pts = sf->pts;
+  std::vector<Eigen::Vector3d> pts = sf->pts;
   Plane F = fitPlane(pts, sf->area);
   if (F.normal.dot(P.normal) < 0) F.normal = -F.normal;
+  // The face cut again by its own plane, twice: where P is tilted, the band takes a wedge of a
+  // curved face (deeper at its low end), whose plane is tilted back by only three quarters of
+  // the tilt (a rod lying 2 degrees off along it); cut by F it is a strip of even depth. A flat
+  // face is the same cut either way.
+  if (curved) {
+    const std::vector<Eigen::Vector3d> v = inG(object_O, X_GO);
+    for (int i = 0; i < 2; ++i) {
+      const SupportFace g = faceAbove(object_O, v, F.normal, params);
+      if (g.pts.size() < 3) break;
+      Plane G = fitPlane(g.pts, g.area);
+      if (G.normal.dot(P.normal) < 0) G.normal = -G.normal;
+      F = G;
+      pts = g.pts;
+    }
+  }
   const double tilt = std::acos(std::clamp(F.normal.dot(P.normal), -1.0, 1.0));
   if (tilt < params.min_tilt_deg * M_PI / 180.0 || tilt > params.max_tilt_deg * M_PI / 180.0) return std::nullopt;
   if (area_G && !flatUnder(*area_G, pts, P, params.area_tol)) return std::nullopt;

@@ -119,6 +119,48 @@ TEST(Scans, ABottomBulgedByTheScanIsReleasedLevel) {
   expectStaysOnTheTrueTable(truth, table, c, 0.2);
 }
 
+// A ring lying on a table (a curved tube: it rests on its underside's strip) scanned with two
+// bumps 3 mm proud under it, 60 degrees apart, and a patch of its top not seen (an open scan):
+// the scan rests on its bumps, tilted, as a curved tube's scan rests on the noise of its lowest
+// points. Its release is levelled on the strip's plane and the true ring stays; without the
+// noise band (scan_noise 0) it is released tilted.
+TEST(Scans, ARingLyingOnBumpsOfItsScanIsReleasedLevel) {
+  const int segments = 48, sides = 24;  // facets 15 degrees round the tube: a curved strip
+  const Mesh truth = scenes::torus(0.05, 0.012, segments, sides);
+  std::vector<Eigen::Vector3d> v = truth.vertices;
+  const double bump = 0.003;
+  for (int i : {0, 8}) v[i * sides + 18].z() -= bump;  // side 18: the underside (scenes::torus)
+  std::vector<std::vector<int>> faces;
+  for (int i = 0; i < segments; ++i)
+    for (int j = 0; j < sides; ++j) {
+      if (j == 6 && i >= 20 && i < 24) continue;  // side 6, the top: not seen
+      const int a = i * sides + j, b = ((i + 1) % segments) * sides + j;
+      faces.push_back({a, b, ((i + 1) % segments) * sides + (j + 1) % sides, i * sides + (j + 1) % sides});
+    }
+  const Mesh scan = buildMesh(v, faces, "bumped ring scan");
+  const Mesh table = scenes::table();
+  auto tiltOf = [&](const PlannerConfig& cfg) {
+    const PlanResult r = Planner().plan(scan, table, cfg);
+    const Candidate* c = best(r);
+    EXPECT_NE(c, nullptr);
+    if (!c) return std::make_pair(180.0, Candidate());
+    // Lying on either side: the ring's axis off the vertical.
+    return std::make_pair(std::acos(std::min(1.0, std::abs(c->X_WO.linear().col(2).z()))) * 180 / M_PI, *c);
+  };
+  PlannerConfig cfg;
+  cfg.threads = 2;
+  const auto [levelled, c] = tiltOf(cfg);
+  EXPECT_LT(levelled, 0.6) << "released off level";
+  cfg.scan_noise = 0;
+  EXPECT_GT(tiltOf(cfg).first, 1.0) << "the bumps did not tilt the rest: the test shows nothing";
+  // The true ring: on the table, or above it by the bumps that hold the scan up, and it stays.
+  const double z = lowestZ(truth, c.X_WO);
+  EXPECT_GE(z, -0.001) << "the true ring is inside the table";
+  EXPECT_LE(z, bump + 0.001) << "the true ring floats above the table";
+  const auto check = bullet(truth, table, c, 0.2);
+  EXPECT_TRUE(check.confirmed) << "moved " << check.moved_m << " m, turned " << check.turned_deg << " deg";
+}
+
 // A contact on the rim of an open region needs unseen surface when the region faces the surface
 // it is on: the part never seen may bulge past that surface (a mug laid on the side the hand hid).
 // The box scanned from above: its open bottom faces down (O), its rim is the side walls' lower edges.

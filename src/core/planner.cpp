@@ -358,7 +358,8 @@ struct PlanRun {
   StopSignal stop;
   std::function<bool()> setup_going = [this] { return keepGoing(t0, budget, progress, Progress{}, result); };
   PlanStats& st() { return result.stats; }
-  bool run_completion() const { return completion.completed(); }
+  // A scan: open (capped), or closed and said to be one (PlannerConfig::closed_scan).
+  bool scanned() const { return completion.completed() || config.closed_scan; }
 };
 
 // The models (III, V-B) and what the steps need of them. Frames: W planning, G gravity -z.
@@ -540,8 +541,8 @@ class TreeSearch {
         m_(m),
         roots_(r.floor_G, r.orientations, m.searched(run.object).properties, *m.am, m.d_vis, r.hanging),
         ctx_(treeContext(m.searched(run.object), m.om, *m.am, *m.backend, m.rad, run.config, run.st(),
-                         run.run_completion())),
-        rp_(robustnessParams(run.config, run.run_completion())),
+                         run.scanned())),
+        rp_(robustnessParams(run.config, run.scanned())),
         // With the robustness check on, the search leaves a share of the budget for it.
         monitor_{m.om, *m.am, run.config, run.progress, run.t0,
                  run.budget * (run.config.robust_check ? kSearchShareOfBudget : 1.0), m.rad.r,
@@ -580,7 +581,7 @@ class TreeSearch {
     for (const auto& [leaf, rb] : monitor_.checked)
       if (config.robustShare(rb.share(), leaves_[leaf].hanging)) in.robust_leaves.push_back(leaf);
     in.cut = [this] { return run_.result.cancelled || run_.result.timed_out; };
-    if (run_.run_completion() || !m_.am->open_edges.empty()) {
+    if (run_.scanned() || !m_.am->open_edges.empty()) {
       // A contact on a cap of the object, away from the seen rim by more than the contact
       // spheres' reach, or a contact the object leans on (its normal outside the friction cone
       // about the vertical: a wall, a peg's side) at the border of what the area's scan saw
@@ -591,7 +592,7 @@ class TreeSearch {
         const TreeLeaf& l = leaves_[i];
         const Eigen::Isometry3d X_OG = toIsometry(l.X_GO).inverse();
         for (const ContactPoint& c : l.contacts) {
-          if (run_.run_completion() && (onCompletedSurface(run_.completion, X_OG * c.p_W, margin) ||
+          if (run_.scanned() && (onCompletedSurface(run_.completion, X_OG * c.p_W, margin) ||
                                         onOpenRimFacing(run_.completion, X_OG * c.p_W, X_OG.linear() * c.n_W, margin)))
             return SupportKind::kCompleted;
           if (c.n_W.z() < floor_cos && nearOpenEdge(m_.am->open_edges, c.p_W, margin))  // G: z up
@@ -775,7 +776,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   int spikes = 0;
   Mesh scan;  // outlives the completion, which refers to it when it was despiked
   Completion completion = completeOpenRegions(object);
-  if (completion.completed()) {
+  if (completion.completed() || config.closed_scan) {
     scan = despiked(object, config.scan_noise, &spikes);
     if (spikes > 0) completion = completeOpenRegions(scan);
   }
@@ -817,8 +818,8 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // A scan's true surface may lie scan_noise beyond it: a scanned object is cleared by that too.
   clearOfTheArea(*models, config, kResultClearance + (completion.completed() ? config.scan_noise : 0.0),
                  run.result.candidates);
-  levelOnTheSupport(*models, models->searched(run.object), config, run.run_completion(), run.result.candidates);
-  if (run.run_completion()) curvedSupportsLast(models->searched(run.object), models->am->R_GW, config, run.result.candidates);
+  levelOnTheSupport(*models, models->searched(run.object), config, run.scanned(), run.result.candidates);
+  if (run.scanned()) curvedSupportsLast(models->searched(run.object), models->am->R_GW, config, run.result.candidates);
   // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
   // released higher by the scan's noise or by how far the unseen may reach, whichever is more
   // (config.h scan_unseen_reach), with its path and pre-place pose. A hanging one is raised by

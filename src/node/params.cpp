@@ -299,6 +299,7 @@ NodeConfig loadNodeConfig(const ros::NodeHandle& nh) {
   r.read("min_edge_clearance", &p.min_edge_clearance);
   r.read("scan_noise", &p.scan_noise);
   r.read("scan_unseen_reach", &p.scan_unseen_reach);
+  r.read("closed_scan", &p.closed_scan);
   try {
     p.rank_order = rankOrderFromName(rank_order);
     p.placement = placementKindFromString(placement);

@@ -53,7 +53,7 @@ constexpr double kCancelLatency = 0.5;
 // another test running beside it (run_tests -j2).
 constexpr double kFeedbackGap = 0.3;
 // sizeof(PlannerConfig) when the YAML was last brought in line with it (x86-64, g++ 12).
-constexpr size_t kPlannerConfigSize = 608;
+constexpr size_t kPlannerConfigSize = 624;
 
 // The scene of the quick goals: a box on a 0.4 x 0.3 m plane at z = 0.
 Mesh testArea() { return scenes::plane(0.4, 0.3); }
@@ -1170,7 +1170,7 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
         "max_object_size", "max_area_size", "max_gripper_tilt_deg", "gripper_min_clearance",
         "keep_colliding", "approach_distance", "approach_min_distance", "retreat_distance",
         "retreat_min_distance", "rank_order", "prefer_near", "min_edge_clearance", "scan_noise",
-        "scan_unseen_reach", "robot_description_param", "urdf_file", "gripper_links", "gripper_joint_positions",
+        "scan_unseen_reach", "closed_scan", "robot_description_param", "urdf_file", "gripper_links", "gripper_joint_positions",
         "gripper_mesh_dir", "object_shape_frame", "placement_area_shape_frame"}) {
     EXPECT_TRUE(nh.hasParam(name)) << name << " missing from config/place_planner.yaml";
   }
@@ -1224,6 +1224,7 @@ TEST(PlacePlannerParams, YamlMirrorsPlannerConfigDefaults) {
   EXPECT_EQ(y.min_edge_clearance, d.min_edge_clearance);
   EXPECT_EQ(y.scan_noise, d.scan_noise);
   EXPECT_EQ(y.scan_unseen_reach, d.scan_unseen_reach);
+  EXPECT_EQ(y.closed_scan, d.closed_scan);
   // has_grasp, grasp: per goal; gripper: loaded from gripper_links (the .test file sets them).
   EXPECT_EQ(y.has_grasp, d.has_grasp);
   // The struct's size: a new field changes it; then list it above and in the YAML.

@@ -161,6 +161,36 @@ TEST(Scans, ARingLyingOnBumpsOfItsScanIsReleasedLevel) {
   EXPECT_TRUE(check.confirmed) << "moved " << check.moved_m << " m, turned " << check.turned_deg << " deg";
 }
 
+// The same bumped ring scanned all around, its mesh closed: taken as exact by default (its rest
+// on the bumps kept), as a scan with closed_scan (levelled on its strip).
+TEST(Scans, AClosedScanIsAScanWhenSaidToBe) {
+  const int segments = 48, sides = 24;
+  std::vector<Eigen::Vector3d> v = scenes::torus(0.05, 0.012, segments, sides).vertices;
+  for (int i : {0, 8}) {
+    v[i * sides + 18].z() -= 0.003;  // bumps on both sides: it lies on either
+    v[i * sides + 6].z() += 0.003;
+  }
+  std::vector<std::vector<int>> faces;
+  for (int i = 0; i < segments; ++i)
+    for (int j = 0; j < sides; ++j)
+      faces.push_back({i * sides + j, ((i + 1) % segments) * sides + j, ((i + 1) % segments) * sides + (j + 1) % sides,
+                       i * sides + (j + 1) % sides});
+  const Mesh scan = buildMesh(v, faces, "bumped ring scanned all around");
+  ASSERT_TRUE(openEdges(scan).empty());
+  auto tiltOf = [&](bool closed_scan) {
+    PlannerConfig cfg;
+    cfg.threads = 2;
+    cfg.closed_scan = closed_scan;
+    const Candidate* c = nullptr;
+    const PlanResult r = Planner().plan(scan, scenes::table(), cfg);
+    c = best(r);
+    EXPECT_NE(c, nullptr);
+    return c ? std::acos(std::min(1.0, std::abs(c->X_WO.linear().col(2).z()))) * 180 / M_PI : 180.0;
+  };
+  EXPECT_GT(tiltOf(false), 1.0) << "a closed mesh is exact by default";
+  EXPECT_LT(tiltOf(true), 0.6) << "said to be a scan, it is levelled";
+}
+
 // A contact on the rim of an open region needs unseen surface when the region faces the surface
 // it is on: the part never seen may bulge past that surface (a mug laid on the side the hand hid).
 // The box scanned from above: its open bottom faces down (O), its rim is the side walls' lower edges.

@@ -57,6 +57,36 @@ void expectStaysOnTheTrueTable(const Mesh& truth, const Mesh& table, const Candi
   EXPECT_TRUE(check.confirmed) << "moved " << check.moved_m << " m, turned " << check.turned_deg << " deg";
 }
 
+// The best stable candidate planned on `scan` and how far the object's z axis is off the
+// vertical, either way up (180 with none).
+std::pair<double, Candidate> bestAndAxisTilt(const Mesh& scan, const Mesh& area, const PlannerConfig& cfg) {
+  const PlanResult r = Planner().plan(scan, area, cfg);
+  const Candidate* c = best(r);
+  EXPECT_NE(c, nullptr);
+  if (!c) return {180.0, Candidate()};
+  return {std::acos(std::min(1.0, std::abs(c->X_WO.linear().col(2).z()))) * 180 / M_PI, *c};
+}
+
+// A ring (torus R 5 cm, tube 1.2 cm, 24 facets round the tube: a curved strip) whose scan has
+// bumps 3 mm proud at two points of its underside 60 degrees apart (and of its top, `both`),
+// with a patch of its top not seen (`open`).
+Mesh bumpedRing(bool open, bool both) {
+  const int segments = 48, sides = 24;
+  std::vector<Eigen::Vector3d> v = scenes::torus(0.05, 0.012, segments, sides).vertices;
+  for (int i : {0, 8}) {
+    v[i * sides + 18].z() -= 0.003;  // side 18: the underside (scenes::torus), side 6 the top
+    if (both) v[i * sides + 6].z() += 0.003;
+  }
+  std::vector<std::vector<int>> faces;
+  for (int i = 0; i < segments; ++i)
+    for (int j = 0; j < sides; ++j) {
+      if (open && j == 6 && i >= 20 && i < 24) continue;
+      faces.push_back({i * sides + j, ((i + 1) % segments) * sides + j, ((i + 1) % segments) * sides + (j + 1) % sides,
+                       i * sides + (j + 1) % sides});
+    }
+  return buildMesh(v, faces, "bumped ring scan");
+}
+
 TEST(Scans, BoxScannedFromAboveRestsOnASeenFace) {
   const Mesh box = scenes::box(0.08, 0.06, 0.04);
   const Mesh scan = openBottomBox(box);
@@ -97,19 +127,7 @@ TEST(Scans, ABottomBulgedByTheScanIsReleasedLevel) {
   std::vector<std::vector<int>> faces = truth.patches;
   const Mesh scan = buildMesh(v, faces, "bulged bottle");
   const Mesh table = scenes::table();
-  auto tiltOf = [&](const PlannerConfig& cfg) {
-    const Candidate* c = nullptr;
-    const PlanResult r = Planner().plan(scan, table, cfg);
-    for (const auto& k : r.candidates)
-      if (k.stable) {
-        c = &k;
-        break;
-      }
-    EXPECT_NE(c, nullptr);
-    if (!c) return std::make_pair(180.0, Candidate());
-    // Standing on either end: the axis off the vertical.
-    return std::make_pair(std::acos(std::min(1.0, std::abs(c->X_WO.linear().col(2).z()))) * 180 / M_PI, *c);
-  };
+  auto tiltOf = [&](const PlannerConfig& cfg) { return bestAndAxisTilt(scan, table, cfg); };  // either end
   PlannerConfig cfg;
   cfg.threads = 2;
   const auto [levelled, c] = tiltOf(cfg);
@@ -125,28 +143,11 @@ TEST(Scans, ABottomBulgedByTheScanIsReleasedLevel) {
 // points. Its release is levelled on the strip's plane and the true ring stays; without the
 // noise band (scan_noise 0) it is released tilted.
 TEST(Scans, ARingLyingOnBumpsOfItsScanIsReleasedLevel) {
-  const int segments = 48, sides = 24;  // facets 15 degrees round the tube: a curved strip
-  const Mesh truth = scenes::torus(0.05, 0.012, segments, sides);
-  std::vector<Eigen::Vector3d> v = truth.vertices;
+  const Mesh truth = scenes::torus(0.05, 0.012, 48, 24);
   const double bump = 0.003;
-  for (int i : {0, 8}) v[i * sides + 18].z() -= bump;  // side 18: the underside (scenes::torus)
-  std::vector<std::vector<int>> faces;
-  for (int i = 0; i < segments; ++i)
-    for (int j = 0; j < sides; ++j) {
-      if (j == 6 && i >= 20 && i < 24) continue;  // side 6, the top: not seen
-      const int a = i * sides + j, b = ((i + 1) % segments) * sides + j;
-      faces.push_back({a, b, ((i + 1) % segments) * sides + (j + 1) % sides, i * sides + (j + 1) % sides});
-    }
-  const Mesh scan = buildMesh(v, faces, "bumped ring scan");
+  const Mesh scan = bumpedRing(true, false);
   const Mesh table = scenes::table();
-  auto tiltOf = [&](const PlannerConfig& cfg) {
-    const PlanResult r = Planner().plan(scan, table, cfg);
-    const Candidate* c = best(r);
-    EXPECT_NE(c, nullptr);
-    if (!c) return std::make_pair(180.0, Candidate());
-    // Lying on either side: the ring's axis off the vertical.
-    return std::make_pair(std::acos(std::min(1.0, std::abs(c->X_WO.linear().col(2).z()))) * 180 / M_PI, *c);
-  };
+  auto tiltOf = [&](const PlannerConfig& cfg) { return bestAndAxisTilt(scan, table, cfg); };  // either side
   PlannerConfig cfg;
   cfg.threads = 2;
   const auto [levelled, c] = tiltOf(cfg);
@@ -164,28 +165,13 @@ TEST(Scans, ARingLyingOnBumpsOfItsScanIsReleasedLevel) {
 // The same bumped ring scanned all around, its mesh closed: taken as exact by default (its rest
 // on the bumps kept), as a scan with closed_scan (levelled on its strip).
 TEST(Scans, AClosedScanIsAScanWhenSaidToBe) {
-  const int segments = 48, sides = 24;
-  std::vector<Eigen::Vector3d> v = scenes::torus(0.05, 0.012, segments, sides).vertices;
-  for (int i : {0, 8}) {
-    v[i * sides + 18].z() -= 0.003;  // bumps on both sides: it lies on either
-    v[i * sides + 6].z() += 0.003;
-  }
-  std::vector<std::vector<int>> faces;
-  for (int i = 0; i < segments; ++i)
-    for (int j = 0; j < sides; ++j)
-      faces.push_back({i * sides + j, ((i + 1) % segments) * sides + j, ((i + 1) % segments) * sides + (j + 1) % sides,
-                       i * sides + (j + 1) % sides});
-  const Mesh scan = buildMesh(v, faces, "bumped ring scanned all around");
+  const Mesh scan = bumpedRing(false, true);  // bumps on both sides: it lies on either
   ASSERT_TRUE(openEdges(scan).empty());
   auto tiltOf = [&](bool closed_scan) {
     PlannerConfig cfg;
     cfg.threads = 2;
     cfg.closed_scan = closed_scan;
-    const Candidate* c = nullptr;
-    const PlanResult r = Planner().plan(scan, scenes::table(), cfg);
-    c = best(r);
-    EXPECT_NE(c, nullptr);
-    return c ? std::acos(std::min(1.0, std::abs(c->X_WO.linear().col(2).z()))) * 180 / M_PI : 180.0;
+    return bestAndAxisTilt(scan, scenes::table(), cfg).first;
   };
   EXPECT_GT(tiltOf(false), 1.0) << "a closed mesh is exact by default";
   EXPECT_LT(tiltOf(true), 0.6) << "said to be a scan, it is levelled";
@@ -275,7 +261,9 @@ void expectStandsUprightOnTheTrueTable(const std::string& scan, const std::strin
   const PlanResult r = Planner().plan(loadMesh(d + "/scans/objects/" + scan), table, cfg);
   const Candidate* c = best(r);
   ASSERT_NE(c, nullptr) << "nothing stable";
-  if (support) EXPECT_EQ(c->support, *support);
+  if (support) {
+    EXPECT_EQ(c->support, *support);
+  }
   EXPECT_GT(c->X_WO.linear().col(2).z(), std::cos(5 * M_PI / 180)) << "not upright";
   expectStaysOnTheTrueTable(loadMesh(d + "/objects/" + truth), table, *c, cfg.friction);
 }

@@ -124,9 +124,10 @@ struct PlannerConfig {
   double scan_unseen_reach = 0.005;
   // A closed object mesh is a scan too (a scan fused all around, closed by its reconstruction):
   // planned with a scan's noise as an open one is (despiked, its curved supports levelled and
-  // ranked after flat ones, its centre-of-mass trials by scan_noise, its rolls not a rest). Off:
-  // a closed mesh is taken as exact, an open one as a scan (doc/method.md, "Closed scans").
-  bool closed_scan = false;
+  // ranked after flat ones, its centre-of-mass trials by scan_noise, its rolls not a rest), and
+  // planned again as exact where no pose holds within that noise (a warning says so). Off: a
+  // closed mesh is exact, a CAD model (doc/method.md, "Closed scans").
+  bool closed_scan = true;
   // Optional region (planning frame) the floor points must lie in; inactive when min > max.
   Eigen::Vector3d region_min{1.0, 1.0, 1.0};
   Eigen::Vector3d region_max{-1.0, -1.0, -1.0};

@@ -215,6 +215,9 @@ class Planner {
   void clearAreaCache() const;
 
  private:
+  // One plan; *closed says whether the object mesh had no open region.
+  PlanResult planOnce(const Mesh& object, const Mesh& area, const PlannerConfig& config,
+                      const ProgressCallback& progress, bool* closed) const;
   std::shared_ptr<AreaModelCache> cache_;
 };
 

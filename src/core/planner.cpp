@@ -771,11 +771,28 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   validate(config);
   if (object.empty()) throw std::invalid_argument("object mesh is empty");
   if (area.empty()) throw std::invalid_argument("placement area mesh is empty");
+  bool closed = false;
+  PlanResult r = planOnce(object, area, config, progress, &closed);
+  // A closed mesh planned as a scan (closed_scan) with no pose that holds within its noise (a
+  // rod whose roll valley is finer than scan_noise): planned again as exact, and said so.
+  if (!config.closed_scan || !closed || r.outcome() != PlanOutcome::kNoStable) return r;
+  PlannerConfig exact = config;
+  exact.closed_scan = false;
+  if (exact.time_budget_ms > 0) exact.time_budget_ms = std::max(1.0, exact.time_budget_ms - r.stats.total_ms);
+  PlanResult again = planOnce(object, area, exact, progress, &closed);
+  again.stats.total_ms += r.stats.total_ms;
+  again.warnings.push_back("no pose of the closed object mesh holds within scan_noise: planned again as an exact mesh (closed_scan)");
+  return again;
+}
+
+PlanResult Planner::planOnce(const Mesh& object, const Mesh& area, const PlannerConfig& config,
+                             const ProgressCallback& progress, bool* closed) const {
   // Unseen is not empty: open regions of a scanned object capped (model/completion.h), after
   // its noise spikes are flattened (model/despike.h; an open mesh is a scan).
   int spikes = 0;
   Mesh scan;  // outlives the completion, which refers to it when it was despiked
   Completion completion = completeOpenRegions(object);
+  *closed = !completion.completed();
   if (completion.completed() || config.closed_scan) {
     scan = despiked(object, config.scan_noise, &spikes);
     if (spikes > 0) completion = completeOpenRegions(scan);

@@ -578,8 +578,10 @@ int main(int argc, char** argv) {
                  "[m] how far a scan's unseen part may reach past a cap: a pose resting on one is released this much higher")
       ->check(kFinite)
       ->capture_default_str();
-  app.add_flag("--closed-scan", c.closed_scan,
-               "the object's mesh, though closed, is a scan (fused all around): planned with its noise as an open scan is");
+  app.add_flag("--closed-scan,!--exact-mesh", c.closed_scan,
+               "a closed object mesh is a scan too (fused all around): planned with its noise as an open scan is, "
+               "and again as exact where nothing holds within it; --exact-mesh: a closed mesh is exact (a CAD model)")
+      ->capture_default_str();
   app.add_option("--min-edge-clearance", c.min_edge_clearance, "[m] from a drop-off of the area, 0 = off")
       ->check(kFinite)
       ->capture_default_str();

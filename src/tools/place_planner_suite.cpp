@@ -50,7 +50,7 @@ double median(std::vector<double> v) {
                "  [--threads N] [--friction MU] [--auto-gravity] [--orientation MODE]\n"
                "  [--robust-shift M] [--robust-tilt-deg D] [--robust-com-offset F] [--robust-min-share S]\n"
                "  [--robust-min-share-hanging S]\n"
-               "  [--no-robust-check] [--no-robust-recheck-caught] [--no-rock-settle] [--closed-scan]\n"
+               "  [--no-robust-check] [--no-robust-recheck-caught] [--no-rock-settle] [--closed-scan|--exact-mesh]\n"
                "  [--scans AREA,...]  the scan suite instead: object scans on the areas' robot-head\n"
                "  scans (DATA/scans), validated on the true meshes; writes OUT/scans.{md,csv}\n"
                "  [--hanging]  the hanging suite instead: looped objects on built-in peg walls and a\n"
@@ -242,6 +242,7 @@ int main(int argc, char** argv) {
     else if (a == "--rock-settle") cfg.planner.rock_settle = true;
     else if (a == "--no-rock-settle") cfg.planner.rock_settle = false;
     else if (a == "--closed-scan") cfg.planner.closed_scan = true;
+    else if (a == "--exact-mesh") cfg.planner.closed_scan = false;
     else usage(("unknown argument " + a).c_str());
   }
   if (out.empty()) usage("--out is required");

@@ -426,7 +426,9 @@ TEST(AreaUp, TiltedSceneIsRecognised) {
   PlannerConfig c;
   c.max_candidates = 3;
   const PlanResult wrong = Planner().plan(scenes::box(0.05, 0.05, 0.05), scene, c);
-  ASSERT_EQ(wrong.warnings.size(), 1u);
+  // Said first; a second warning says the closed box, with nothing stable as a scan, was
+  // planned again as exact (closed_scan).
+  ASSERT_FALSE(wrong.warnings.empty());
   EXPECT_NE(wrong.warnings[0].find("is gravity right?"), std::string::npos);
   c.gravity = -e.up;
   const PlanResult right = Planner().plan(scenes::box(0.05, 0.05, 0.05), scene, c);

@@ -162,9 +162,9 @@ TEST(Scans, ARingLyingOnBumpsOfItsScanIsReleasedLevel) {
   EXPECT_TRUE(check.confirmed) << "moved " << check.moved_m << " m, turned " << check.turned_deg << " deg";
 }
 
-// The same bumped ring scanned all around, its mesh closed: taken as exact by default (its rest
-// on the bumps kept), as a scan with closed_scan (levelled on its strip).
-TEST(Scans, AClosedScanIsAScanWhenSaidToBe) {
+// The same bumped ring scanned all around, its mesh closed: a scan by default (levelled on its
+// strip), taken as exact with closed_scan off (its rest on the bumps kept).
+TEST(Scans, AClosedMeshIsAScanUnlessSaidToBeExact) {
   const Mesh scan = bumpedRing(false, true);  // bumps on both sides: it lies on either
   ASSERT_TRUE(openEdges(scan).empty());
   auto tiltOf = [&](bool closed_scan) {
@@ -173,8 +173,8 @@ TEST(Scans, AClosedScanIsAScanWhenSaidToBe) {
     cfg.closed_scan = closed_scan;
     return bestAndAxisTilt(scan, scenes::table(), cfg).first;
   };
-  EXPECT_GT(tiltOf(false), 1.0) << "a closed mesh is exact by default";
-  EXPECT_LT(tiltOf(true), 0.6) << "said to be a scan, it is levelled";
+  EXPECT_LT(tiltOf(true), 0.6) << "a closed mesh is a scan by default: levelled";
+  EXPECT_GT(tiltOf(false), 1.0) << "said to be exact, it rests on its bumps";
 }
 
 // A contact on the rim of an open region needs unseen surface when the region faces the surface
@@ -227,6 +227,39 @@ TEST(Scans, RollBottomHoldsOnlyOnCrestsAboveTheScansNoise) {
   PlannerConfig exact = cfg;
   exact.scan_noise = 0;
   EXPECT_TRUE(lyingHeld(scan, exact)) << "the scan taken as exact does not hold where the mesh does";
+}
+
+// The closed rod of the test above, as a scan (closed_scan, the default), has no rest within
+// the scan's noise: it is planned again as exact, its lying pose returned with a warning that
+// says so, and the rod stays there in Bullet. Taken as exact from the start, no warning.
+TEST(Scans, AClosedMeshWithNoRestWithinItsNoiseIsPlannedAgainAsExact) {
+  const Mesh upright = scenes::cylinder(0.02, 0.12, 12);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  std::vector<Eigen::Vector3d> v;
+  for (const auto& p : upright.vertices) v.push_back(R * p);
+  const Mesh rod = buildMesh(v, upright.patches, "rod");
+  const Mesh table = scenes::table();
+  PlannerConfig cfg;
+  cfg.threads = 2;
+  cfg.orientation = OrientationMode::kKeep;  // held lying along x: its only rests are rolls
+  auto again = [](const PlanResult& r) {
+    for (const std::string& w : r.warnings)
+      if (w.find("planned again as an exact mesh") != std::string::npos) return true;
+    return false;
+  };
+  const PlanResult r = Planner().plan(rod, table, cfg);
+  const Candidate* b = best(r);
+  ASSERT_NE(b, nullptr) << "nothing returned for the closed rod";
+  EXPECT_TRUE(again(r)) << "the second plan, as exact, was not said";
+  EXPECT_LT(std::abs((b->X_WO.linear() * Eigen::Vector3d::UnitX()).z()), 0.05) << "not lying";
+  const auto check = bullet(rod, table, *b, cfg.friction);
+  EXPECT_TRUE(check.confirmed) << "moved " << check.moved_m << " m, turned " << check.turned_deg << " deg";
+  PlannerConfig exact = cfg;
+  exact.closed_scan = false;
+  const PlanResult e = Planner().plan(rod, table, exact);
+  ASSERT_NE(best(e), nullptr);
+  EXPECT_FALSE(again(e));
+  EXPECT_LT((best(e)->X_WO.translation() - b->X_WO.translation()).norm(), 1e-6) << "not the exact plan's pose";
 }
 
 // With its sides seen, the box may stand on its completed bottom: allowed (stable), flagged.

@@ -74,6 +74,7 @@ bool flatUnder(const MeshModel& area, const std::vector<Eigen::Vector3d>& sample
 // A standing pose's support plane P and its support face, with the face's flatness.
 struct SupportFace {
   Plane P;
+  std::vector<Eigen::Vector3d> v;    // the object's vertices (G)
   std::vector<Eigen::Vector3d> pts;  // samples of the face (G)
   std::vector<double> area;          // ... their weights
   double face_area = 0;              // m^2
@@ -144,9 +145,11 @@ std::optional<SupportFace> supportFace(const Mesh& object_O, const Eigen::Isomet
     if (i < normals_G.size() && normals_G[i].dot(P.normal) < std::cos(M_PI / 4)) return std::nullopt;
   }
   // The support face: the object's surface facing P within `band` of its lowest point over P.
-  SupportFace f = faceAbove(object_O, inG(object_O, X_GO), P.normal, params);
+  std::vector<Eigen::Vector3d> v = inG(object_O, X_GO);
+  SupportFace f = faceAbove(object_O, v, P.normal, params);
   if (f.pts.size() < 3 || f.face_area < params.min_face_area) return std::nullopt;
   f.P = P;
+  f.v = std::move(v);
   return f;
 }
 
@@ -168,9 +171,8 @@ std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen:
   // the tilt (a rod lying 2 degrees off along it); cut by F it is a strip of even depth. A flat
   // face is the same cut either way.
   if (curved) {
-    const std::vector<Eigen::Vector3d> v = inG(object_O, X_GO);
     for (int i = 0; i < 2; ++i) {
-      const SupportFace g = faceAbove(object_O, v, F.normal, params);
+      const SupportFace g = faceAbove(object_O, sf->v, F.normal, params);
       if (g.pts.size() < 3) break;
       Plane G = fitPlane(g.pts, g.area);
       if (G.normal.dot(P.normal) < 0) G.normal = -G.normal;

@@ -773,15 +773,22 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   if (area.empty()) throw std::invalid_argument("placement area mesh is empty");
   bool closed = false;
   PlanResult r = planOnce(object, area, config, progress, &closed);
-  // A closed mesh planned as a scan (closed_scan) with no pose that holds within its noise (a
-  // rod whose roll valley is finer than scan_noise): planned again as exact, and said so.
-  if (!config.closed_scan || !closed || r.outcome() != PlanOutcome::kNoStable) return r;
+  // A closed mesh planned as a scan (closed_scan) with no pose that holds within its noise, where
+  // some pose held by statics (a rod whose roll valley is finer than scan_noise: its rolls, or
+  // trials of the centre of mass moved by the noise): planned again as exact, and said so. With
+  // nothing held even by statics (a ramp steeper than the friction angle) it is not.
+  const bool noise_turned_down = r.stats.roll_bottoms > 0 || r.stats.robustness_checked > 0;
+  if (!config.closed_scan || !closed || r.outcome() != PlanOutcome::kNoStable || !noise_turned_down) return r;
   PlannerConfig exact = config;
   exact.closed_scan = false;
   if (exact.time_budget_ms > 0) exact.time_budget_ms = std::max(1.0, exact.time_budget_ms - r.stats.total_ms);
   PlanResult again = planOnce(object, area, exact, progress, &closed);
-  again.stats.total_ms += r.stats.total_ms;
-  again.warnings.push_back("no pose of the closed object mesh holds within scan_noise: planned again as an exact mesh (closed_scan)");
+  again.stats.total_ms += r.stats.total_ms;  // both plans' time, from the call
+  if (again.stats.first_stable_ms >= 0) again.stats.first_stable_ms += r.stats.total_ms;
+  char noise[32];
+  std::snprintf(noise, sizeof noise, "%.1f mm", 1e3 * config.scan_noise);
+  again.warnings.push_back(std::string("no pose of the closed object mesh holds within scan_noise (") + noise +
+                           "): planned again as an exact mesh, so its poses trust the mesh's shape finer than a scan's noise (closed_scan)");
   return again;
 }
 

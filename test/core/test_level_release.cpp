@@ -44,9 +44,15 @@ TEST(LevelRelease, LeavesALevelFaceALargeTiltAndALeanAsTheyAre) {
   EXPECT_FALSE(levelingTurn(TiltedBox(0.0).box, TiltedBox(0.0).X, TiltedBox(0.0).contacts, TiltedBox(0.0).normals,
                             LevelReleaseParams()).has_value())
       << "level already";
-  const TiltedBox steep(8.0);
+  const TiltedBox steep(12.0);
   EXPECT_FALSE(levelingTurn(steep.box, steep.X, steep.contacts, steep.normals, LevelReleaseParams()).has_value())
-      << "8 degrees is not a scan's noise";
+      << "12 degrees is not a scan's error";
+  // 8 degrees is: a face seen at a grazing angle next to a scan's open rim bends by millimetres
+  // (a held-out bracket seen from above rested on its side 8 degrees off).
+  const TiltedBox bent(8.0);
+  const auto turn = levelingTurn(bent.box, bent.X, bent.contacts, bent.normals, LevelReleaseParams());
+  ASSERT_TRUE(turn.has_value()) << "8 degrees left as it was";
+  EXPECT_LT(tiltDeg((*turn * bent.X).linear()), 0.01);
   // Contacts that push sideways (a wall): not a face resting on a plane.
   TiltedBox lean(2.0);
   lean.normals[2] = Eigen::Vector3d(0, -1, 0.2).normalized();

@@ -25,7 +25,7 @@ struct LevelReleaseParams {
   double band = 0.006;                  // m: the support face's depth above the support plane
   double facing_deg = 30.0;             // its triangles face the plane within this
   double min_tilt_deg = 0.2;            // a face already this level is left as it is
-  double max_tilt_deg = 5.0;            // a larger tilt is not the scan's noise: left as it is
+  double max_tilt_deg = 10.0;           // a larger tilt is not the scan's error: left as it is
   double min_face_area = 1e-4;          // m^2 of support face, at least
   double max_curve_deg = 15.0;          // flat: its normals' area-weighted mean at least cos of it long
   bool curved = true;                   // curved faces levelled too (a scan's; off: flat ones only)

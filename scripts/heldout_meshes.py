@@ -29,6 +29,26 @@ def extrude(poly, h, tris):
     return V, F
 
 
+def revolve(profile, n=32):
+    """A solid of revolution about z: (radius, height) from the bottom's middle to the top's."""
+    V, F, rings = [], [], []
+    for r, z in profile:
+        if r == 0:
+            rings.append([len(V)]); V.append((0, 0, z))
+        else:
+            rings.append(list(range(len(V), len(V) + n)))
+            V += [(r * math.cos(2 * math.pi * k / n), r * math.sin(2 * math.pi * k / n), z) for k in range(n)]
+    for A, B in zip(rings, rings[1:]):
+        for k in range(n):
+            if len(A) == 1:
+                F.append((A[0], B[(k + 1) % n], B[k]))
+            elif len(B) == 1:
+                F.append((A[k], A[(k + 1) % n], B[0]))
+            else:
+                F += [(A[k], A[(k + 1) % n], B[(k + 1) % n]), (A[k], B[(k + 1) % n], B[k])]
+    return V, F
+
+
 def write_second(out):
     r = 0.028  # a hexagonal prism 5.6 cm across its corners, 16 cm long along x, on a flat face
     V, F = extrude([(r * math.cos(math.pi / 3 * k), r * math.sin(math.pi / 3 * k)) for k in range(6)], 0.16,
@@ -53,54 +73,18 @@ def write_second(out):
             c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
             F += [(a, b, c), (a, c, d)]
     write(out, "torus", V, F)
-    k = 32  # a frustum: 12 cm across at the bottom, 7 at the top, 9 cm tall
-    V, F, rings = [], [], []
-    for rr, z in ((0, 0), (0.06, 0), (0.035, 0.09), (0, 0.09)):
-        rings.append([len(V)] if rr == 0 else list(range(len(V), len(V) + k)))
-        V += [(0, 0, z)] if rr == 0 else [(rr * math.cos(2 * math.pi * i / k), rr * math.sin(2 * math.pi * i / k), z) for i in range(k)]
-    for A, B in zip(rings, rings[1:]):
-        for i in range(k):
-            if len(A) == 1:
-                F.append((A[0], B[(i + 1) % k], B[i]))
-            elif len(B) == 1:
-                F.append((A[i], A[(i + 1) % k], B[0]))
-            else:
-                F += [(A[i], A[(i + 1) % k], B[(i + 1) % k]), (A[i], B[(i + 1) % k], B[i])]
-    write(out, "frustum", V, F)
+    write(out, "frustum", *revolve([(0, 0), (0.06, 0), (0.035, 0.09), (0, 0.09)]))  # a lamp's base, 9 cm tall
     bx, by, bz = 0.07, 0.07, 0.20  # a tall carton
     V = [(a, b, c) for c in (0, bz) for (a, b) in [(0, 0), (bx, 0), (bx, by), (0, by)]]
     write(out, "carton", V, [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)])
 
 
 def write_objects(out):
-    def write(name, V, F):
-        with open(f"{out}/{name}.ply", "w") as o:
-            o.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\nproperty double y\n"
-                    "property double z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n" % (len(V), len(F)))
-            o.writelines("%.6f %.6f %.6f\n" % v for v in V)
-            o.writelines("%d %s\n" % (len(f), " ".join(map(str, f))) for f in F)
-    def revolve(profile, n=32):  # (radius, height) from the bottom's middle to the top's, about z
-        V, F, rings = [], [], []
-        for r, z in profile:
-            if r == 0:
-                rings.append([len(V)]); V.append((0, 0, z))
-            else:
-                rings.append(list(range(len(V), len(V) + n)))
-                V += [(r * math.cos(2 * math.pi * k / n), r * math.sin(2 * math.pi * k / n), z) for k in range(n)]
-        for A, B in zip(rings, rings[1:]):
-            for k in range(n):
-                if len(A) == 1:
-                    F.append((A[0], B[(k + 1) % n], B[k]))
-                elif len(B) == 1:
-                    F.append((A[k], A[(k + 1) % n], B[0]))
-                else:
-                    F += [(A[k], A[(k + 1) % n], B[(k + 1) % n]), (A[k], B[(k + 1) % n], B[k])]
-        return V, F
-    write("can", *revolve([(0, 0), (0.033, 0), (0.033, 0.12), (0, 0.12)]))
-    write("cone", *revolve([(0, 0), (0.045, 0), (0.01, 0.09), (0, 0.09)]))
-    write("glass", *revolve([(0, 0), (0.035, 0), (0.035, 0.004), (0.005, 0.006), (0.004, 0.07), (0.03, 0.09),
+    write(out, "can", *revolve([(0, 0), (0.033, 0), (0.033, 0.12), (0, 0.12)]))
+    write(out, "cone", *revolve([(0, 0), (0.045, 0), (0.01, 0.09), (0, 0.09)]))
+    write(out, "glass", *revolve([(0, 0), (0.035, 0), (0.035, 0.004), (0.005, 0.006), (0.004, 0.07), (0.03, 0.09),
                              (0.04, 0.14), (0, 0.14)]))
-    write("bottle", *revolve([(0, 0), (0.035, 0), (0.035, 0.17), (0.012, 0.21), (0.012, 0.24), (0, 0.24)]))
+    write(out, "bottle", *revolve([(0, 0), (0.035, 0), (0.035, 0.17), (0.012, 0.21), (0.012, 0.24), (0, 0.24)]))
     # A tube along a 12 cm arc of +-0.6 rad, 1.8 cm across at its middle tapering to 0.7 cm, capped.
     n, m, R, r = 16, 24, 0.12, 0.018
     V, F, rows = [], [], []
@@ -117,11 +101,11 @@ def write_objects(out):
         c = len(V)
         V.append(tuple(sum(V[j][q] for j in row) / n for q in range(3)))
         F += [(c, row[(k + 1) % n], row[k]) if sign > 0 else (c, row[k], row[(k + 1) % n]) for k in range(n)]
-    write("banana", V, F)
+    write(out, "banana", V, F)
     bx, by, bz = 0.15, 0.22, 0.03  # a book
     V = [(a, b, c) for c in (0, bz) for (a, b) in [(0, 0), (bx, 0), (bx, by), (0, by)]]
     F = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
-    write("book", V, F)
+    write(out, "book", V, F)
 
 
 if __name__ == "__main__":

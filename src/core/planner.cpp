@@ -690,9 +690,9 @@ void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, st
 
 // The levelling's parameters: the support face within three times the scan's noise of the
 // contacts' plane, the area under it that plane within the noise. A curved support is levelled
-// on a scan only (closed too, with closed_scan): on the exact meshes a curved rest is tilted from its strip's
-// plane by the shape itself (the marker's cap: 1.3-3 degrees), and levelled there Bullet turned
-// the 1k marker 19 degrees in the divided tray.
+// on a scan only (a closed one too, with closed_scan): on an exact mesh a curved rest is tilted
+// from its strip's plane by the shape itself (the marker's cap: 1.3-3 degrees), and levelled
+// there Bullet turned the 1k marker 19 degrees in the divided tray.
 LevelReleaseParams levelParams(const PlannerConfig& config, bool scanned) {
   LevelReleaseParams lp;
   lp.band = 3.0 * config.scan_noise;

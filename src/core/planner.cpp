@@ -564,8 +564,13 @@ class TreeSearch {
       run_.st().trees_without_rest += !l.at_rest;
       run_.st().roll_bottoms += l.rolled;
       run_.st().trees_fallen += l.fell;
+      rolls_not_held_ += l.rolled && !l.stable;
     }
   }
+
+  // Trees that ended lying at the bottom of a roll that does not hold a release (its crests
+  // lower than the shape's uncertainty, or than kMinRollRise: tree_stepper.cpp).
+  int rollsNotHeld() const { return rolls_not_held_; }
 
   // Ranking (VI's Q, robust stability, re-orientation, the gripper's placement).
   void rank(const Roots& r) {
@@ -646,6 +651,7 @@ class TreeSearch {
   const TreeContext ctx_;
   const RobustnessParams rp_;
   std::vector<TreeLeaf> leaves_;
+  int rolls_not_held_ = 0;
   SearchMonitor monitor_;
 };
 
@@ -858,6 +864,18 @@ PlanResult Planner::planOnce(const Mesh& object, const Mesh& area, const Planner
   }
   // The first robust stable pose was found by the ranking (the search's checks were bounded).
   if (run.st().first_stable_ms < 0 && run.result.stableCount() > 0) run.st().first_stable_ms = msSince(run.t0);
+  // Nothing stable on a scan where trees ended lying on a roll: why, and what would help. Where a
+  // nearly round object comes to rest about its axis is finer than a scan's noise (the marker:
+  // valleys 0.2 mm deep under 2 mm of noise; doc/method.md, "Closed scans").
+  if (run.scanned() && run.result.stableCount() == 0 && search.rollsNotHeld() > 0) {
+    char msg[320];
+    std::snprintf(msg, sizeof msg,
+                  "nothing stable: %d trees ended lying on a roll that does not hold a release within scan_noise "
+                  "(%.1f mm): where this object comes to rest about its axis is finer than its scan (a finer scan: "
+                  "a smaller scan_noise)",
+                  search.rollsNotHeld(), 1e3 * config.scan_noise);
+    run.result.warnings.push_back(msg);
+  }
   if (run.budget > 0 && msSince(run.t0) > run.budget) run.result.timed_out = true;
   run.st().total_ms = msSince(run.t0);
   return std::move(run.result);

@@ -202,6 +202,7 @@ TEST(Scans, ContactOnTheRimOfAnOpenRegionFacingItsSurfaceNeedsUnseenSurface) {
 // lifts it (tree_stepper.cpp). On a scan, a crest lower than the scan's noise is no evidence: a
 // 12-sided rod 4 cm across (crests 0.68 mm) holds lying as a mesh, not as a scan (one end
 // unseen) with the default scan_noise (2 mm), and holds again as that scan with scan_noise 0.
+// With nothing stable, the answer's warnings say that its rolls were turned down by the noise.
 TEST(Scans, RollBottomHoldsOnlyOnCrestsAboveTheScansNoise) {
   const Mesh upright = scenes::cylinder(0.02, 0.12, 12);
   const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -224,6 +225,13 @@ TEST(Scans, RollBottomHoldsOnlyOnCrestsAboveTheScansNoise) {
   };
   EXPECT_TRUE(lyingHeld(rod, cfg)) << "the mesh's crests hold it";
   EXPECT_FALSE(lyingHeld(scan, cfg)) << "crests under scan_noise held the scan";
+  // Nothing else holds it as held: the answer says why, naming the roll and scan_noise.
+  const PlanResult s = Planner().plan(scan, table, cfg);
+  EXPECT_EQ(s.outcome(), PlanOutcome::kNoStable);
+  bool said = false;
+  for (const std::string& w : s.warnings)
+    said = said || (w.find("ended lying on a roll") != std::string::npos && w.find("scan_noise (2.0 mm)") != std::string::npos);
+  EXPECT_TRUE(said) << "no stable pose, and no word of the rolls the scan's noise turned down";
   PlannerConfig exact = cfg;
   exact.scan_noise = 0;
   EXPECT_TRUE(lyingHeld(scan, exact)) << "the scan taken as exact does not hold where the mesh does";

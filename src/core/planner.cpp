@@ -694,19 +694,6 @@ void clearOfTheArea(const Models& m, const PlannerConfig& config, double gap, st
   std::stable_partition(candidates.begin(), candidates.end(), [](const Candidate& c) { return c.stable; });
 }
 
-// The levelling's parameters: the support face within three times the scan's noise of the
-// contacts' plane, the area under it that plane within the noise. A curved support is levelled
-// on a scan only (a closed one too, with closed_scan): on an exact mesh a curved rest is tilted
-// from its strip's plane by the shape itself (the marker's cap: 1.3-3 degrees), and levelled
-// there Bullet turned the 1k marker 19 degrees in the divided tray.
-LevelReleaseParams levelParams(const PlannerConfig& config, bool scanned) {
-  LevelReleaseParams lp;
-  lp.band = 3.0 * config.scan_noise;
-  lp.area_tol = config.scan_noise;
-  lp.curved = scanned;
-  return lp;
-}
-
 // A candidate's contact points and normals in the gravity frame G.
 void contactsInG(const Candidate& c, const Eigen::Isometry3d& X_GW, std::vector<Eigen::Vector3d>& p,
                  std::vector<Eigen::Vector3d>& n) {
@@ -723,7 +710,7 @@ void contactsInG(const Candidate& c, const Eigen::Isometry3d& X_GW, std::vector<
 // out of the area where the turn took part of it in (clearingShift), or left as it was.
 void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfig& config, bool scanned,
                        std::vector<Candidate>& candidates) {
-  const LevelReleaseParams lp = levelParams(config, scanned);
+  const LevelReleaseParams lp = levelReleaseParams(config.scan_noise, scanned);
   if (lp.band <= 0) return;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = m.am->R_GW;
@@ -751,7 +738,7 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
 // holds whatever the scan's noise (doc/method.md, "Curved supports after flat ones").
 void curvedSupportsLast(const Mesh& object_O, const Eigen::Matrix3d& R_GW, const PlannerConfig& config,
                         std::vector<Candidate>& candidates) {
-  const LevelReleaseParams lp = levelParams(config, true);  // the support face as levelOnTheSupport takes it
+  const LevelReleaseParams lp = levelReleaseParams(config.scan_noise, true);  // the support face as levelOnTheSupport takes it
   if (lp.band <= 0) return;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = R_GW;

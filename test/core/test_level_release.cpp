@@ -90,6 +90,37 @@ TEST(LevelRelease, LevelsUpToTheScansEdgeNotOverAStep) {
   EXPECT_FALSE(levelled(scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.01)}))) << "a step";
 }
 
+// The planner's parameters (levelReleaseParams) take the area under the face as the plane within
+// twice the scan's noise: the plane is fitted through contacts on the same noisy surface. A board
+// whose last rows under part of the face lie 3 mm low (a table scan's ragged front edge stands
+// 2-4 mm off its plane) is the plane for them, not for a tolerance of the noise alone; a step of
+// 1 cm is not. The can's bottom, tilted 2 degrees, as above.
+TEST(LevelRelease, LevelsOverAScansRaggedEdgeWithinTwiceItsNoise) {
+  const Mesh can = scenes::cylinder(0.04, 0.1, 48);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  double low = 1e9;
+  for (const auto& v : can.vertices) low = std::min(low, (X * v).z());
+  X.translation().z() = -low;
+  const std::vector<Eigen::Vector3d> contacts = {{-0.03, -0.03, 0}, {0.03, -0.03, 0}, {0.0, 0.035, 0}};
+  const std::vector<Eigen::Vector3d> up(3, Eigen::Vector3d::UnitZ());
+  auto board = [](double x0, double x1, double z) {
+    return scenes::box(x1 - x0, 0.3, 0.01, Eigen::Vector3d(0.5 * (x0 + x1), 0, z - 0.005));
+  };
+  auto levelled = [&](const Mesh& area, const LevelReleaseParams& lp) {
+    const AreaModel am = buildAreaModel(area, Eigen::Vector3d(0, 0, -1), 0.001, 0.002, 0.002);
+    return levelingTurn(can, X, contacts, up, lp, &am).has_value();
+  };
+  const LevelReleaseParams planner = levelReleaseParams(0.002, true);
+  EXPECT_DOUBLE_EQ(planner.area_tol, 0.004);
+  const Mesh ragged = scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.003)});
+  EXPECT_TRUE(levelled(ragged, planner)) << "rows 3 mm low under a quarter of the face ruled the plane out";
+  LevelReleaseParams noise_only = planner;
+  noise_only.area_tol = 0.002;
+  EXPECT_FALSE(levelled(ragged, noise_only)) << "the board's low rows are not 3 mm off";
+  EXPECT_FALSE(levelled(scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.01)}), planner)) << "a step";
+}
+
 // A can lying on its side rests on a curved face; standing, or a box on a face, on a flat one.
 // The contacts: four points of the table under it (z = 0).
 TEST(LevelRelease, ACanOnItsSideRestsOnACurvedFace) {

@@ -33,6 +33,17 @@ struct LevelReleaseParams {
   double area_tol = 0.002;              // m: the area under the face is that plane within this
 };
 
+// The planner's levelling parameters for a scan's noise (m): the support face within three times
+// the noise of the contacts' plane, the area under it that plane within twice the noise (the
+// plane is fitted through contacts on the same noisy surface, so a corner and the plane each
+// stray by up to the noise: a table scan's ragged front edge stands 2-4 mm off it, and a held-out
+// wedge seen in the hand, resting there 3.9 degrees off level, was turned 5.6 degrees by Bullet).
+// A curved support is levelled on a scan only (`scanned`, a closed one too with closed_scan): on
+// an exact mesh a curved rest is tilted from its strip's plane by the shape itself (the marker's
+// cap: 1.3-3 degrees), and levelled there Bullet turned the 1k marker 19 degrees in the divided
+// tray.
+LevelReleaseParams levelReleaseParams(double scan_noise, bool scanned);
+
 // The turn (a rotation about the support face's centroid, frame G) that makes the least-squares
 // plane of the support face of `object_O` at X_GO parallel to the plane of `contacts_G` (their
 // least-squares plane, facing against gravity, with every contact's normal within 45 degrees of

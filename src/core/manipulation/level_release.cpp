@@ -155,6 +155,14 @@ std::optional<SupportFace> supportFace(const Mesh& object_O, const Eigen::Isomet
 
 }  // namespace
 
+LevelReleaseParams levelReleaseParams(double scan_noise, bool scanned) {
+  LevelReleaseParams lp;
+  lp.band = 3.0 * scan_noise;
+  lp.area_tol = 2.0 * scan_noise;
+  lp.curved = scanned;
+  return lp;
+}
+
 std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen::Isometry3d& X_GO,
                                               const std::vector<Eigen::Vector3d>& contacts_G,
                                               const std::vector<Eigen::Vector3d>& normals_G,

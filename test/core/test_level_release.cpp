@@ -64,61 +64,55 @@ TEST(LevelRelease, LeavesALevelFaceALargeTiltAndALeanAsTheyAre) {
   EXPECT_FALSE(levelingTurn(b.box, b.X, b.contacts, b.normals, none).has_value());
 }
 
+// The bottom of a can (radius 4 cm) tilted 2 degrees about x, on z = 0 under three contacts,
+// sampled at its 46 triangles' centroids; levelled() asks whether it is levelled over `area`.
+struct TiltedCan {
+  Mesh can = scenes::cylinder(0.04, 0.1, 48);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3d> contacts = {{-0.03, -0.03, 0}, {0.03, -0.03, 0}, {0.0, 0.035, 0}};
+  std::vector<Eigen::Vector3d> up = std::vector<Eigen::Vector3d>(3, Eigen::Vector3d::UnitZ());
+  TiltedCan() {
+    X.linear() = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    double low = 1e9;
+    for (const auto& v : can.vertices) low = std::min(low, (X * v).z());
+    X.translation().z() = -low;
+  }
+  bool levelled(const Mesh& area, const LevelReleaseParams& lp = LevelReleaseParams()) const {
+    const AreaModel am = buildAreaModel(area, Eigen::Vector3d(0, 0, -1), 0.001, 0.002, 0.002);
+    return levelingTurn(can, X, contacts, up, lp, &am).has_value();
+  }
+};
+// A board 1 cm thick from x0 to x1, its top at z.
+Mesh board(double x0, double x1, double z) {
+  return scenes::box(x1 - x0, 0.3, 0.01, Eigen::Vector3d(0.5 * (x0 + x1), 0, z - 0.005));
+}
+
 // The area under the face: a board whose scan ends short of the face's far side is still the
 // plane there (past the scan's last row nothing says otherwise); a board with a step 1 cm down
-// under part of the face is not, nor is a board under only half of it. The face: the bottom of
-// a can (radius 4 cm) tilted 2 degrees, sampled at its 46 triangles' centroids.
+// under part of the face is not, nor is a board under only half of it.
 TEST(LevelRelease, LevelsUpToTheScansEdgeNotOverAStep) {
-  const Mesh can = scenes::cylinder(0.04, 0.1, 48);
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  double low = 1e9;
-  for (const auto& v : can.vertices) low = std::min(low, (X * v).z());
-  X.translation().z() = -low;
-  const std::vector<Eigen::Vector3d> contacts = {{-0.03, -0.03, 0}, {0.03, -0.03, 0}, {0.0, 0.035, 0}};
-  const std::vector<Eigen::Vector3d> up(3, Eigen::Vector3d::UnitZ());
-  auto board = [](double x0, double x1, double z) {
-    return scenes::box(x1 - x0, 0.3, 0.01, Eigen::Vector3d(0.5 * (x0 + x1), 0, z - 0.005));
-  };
-  auto levelled = [&](const Mesh& area) {
-    const AreaModel am = buildAreaModel(area, Eigen::Vector3d(0, 0, -1), 0.001, 0.002, 0.002);
-    return levelingTurn(can, X, contacts, up, LevelReleaseParams(), &am).has_value();
-  };
-  EXPECT_TRUE(levelled(board(-0.2, 0.2, 0.0))) << "a whole board";
-  EXPECT_TRUE(levelled(board(-0.2, 0.035, 0.0))) << "the scan ends 5 mm short of the face's far side";
-  EXPECT_FALSE(levelled(board(-0.2, 0.0, 0.0))) << "half the face over nothing";
-  EXPECT_FALSE(levelled(scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.01)}))) << "a step";
+  const TiltedCan c;
+  EXPECT_TRUE(c.levelled(board(-0.2, 0.2, 0.0))) << "a whole board";
+  EXPECT_TRUE(c.levelled(board(-0.2, 0.035, 0.0))) << "the scan ends 5 mm short of the face's far side";
+  EXPECT_FALSE(c.levelled(board(-0.2, 0.0, 0.0))) << "half the face over nothing";
+  EXPECT_FALSE(c.levelled(scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.01)}))) << "a step";
 }
 
 // The planner's parameters (levelReleaseParams) take the area under the face as the plane within
 // twice the scan's noise: the plane is fitted through contacts on the same noisy surface. A board
 // whose last rows under part of the face lie 3 mm low (a table scan's ragged front edge stands
 // 2-4 mm off its plane) is the plane for them, not for a tolerance of the noise alone; a step of
-// 1 cm is not. The can's bottom, tilted 2 degrees, as above.
+// 1 cm is not.
 TEST(LevelRelease, LevelsOverAScansRaggedEdgeWithinTwiceItsNoise) {
-  const Mesh can = scenes::cylinder(0.04, 0.1, 48);
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  double low = 1e9;
-  for (const auto& v : can.vertices) low = std::min(low, (X * v).z());
-  X.translation().z() = -low;
-  const std::vector<Eigen::Vector3d> contacts = {{-0.03, -0.03, 0}, {0.03, -0.03, 0}, {0.0, 0.035, 0}};
-  const std::vector<Eigen::Vector3d> up(3, Eigen::Vector3d::UnitZ());
-  auto board = [](double x0, double x1, double z) {
-    return scenes::box(x1 - x0, 0.3, 0.01, Eigen::Vector3d(0.5 * (x0 + x1), 0, z - 0.005));
-  };
-  auto levelled = [&](const Mesh& area, const LevelReleaseParams& lp) {
-    const AreaModel am = buildAreaModel(area, Eigen::Vector3d(0, 0, -1), 0.001, 0.002, 0.002);
-    return levelingTurn(can, X, contacts, up, lp, &am).has_value();
-  };
+  const TiltedCan c;
   const LevelReleaseParams planner = levelReleaseParams(0.002, true);
   EXPECT_DOUBLE_EQ(planner.area_tol, 0.004);
   const Mesh ragged = scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.003)});
-  EXPECT_TRUE(levelled(ragged, planner)) << "rows 3 mm low under a quarter of the face ruled the plane out";
+  EXPECT_TRUE(c.levelled(ragged, planner)) << "rows 3 mm low under a quarter of the face ruled the plane out";
   LevelReleaseParams noise_only = planner;
   noise_only.area_tol = 0.002;
-  EXPECT_FALSE(levelled(ragged, noise_only)) << "the board's low rows are not 3 mm off";
-  EXPECT_FALSE(levelled(scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.01)}), planner)) << "a step";
+  EXPECT_FALSE(c.levelled(ragged, noise_only)) << "the board's low rows are not 3 mm off";
+  EXPECT_FALSE(c.levelled(scenes::merge({board(-0.2, 0.015, 0.0), board(0.015, 0.2, -0.01)}), planner)) << "a step";
 }
 
 // A can lying on its side rests on a curved face; standing, or a box on a face, on a flat one.

@@ -853,7 +853,7 @@ PlanResult Planner::planOnce(const Mesh& object, const Mesh& area, const Planner
   if (run.st().first_stable_ms < 0 && run.result.stableCount() > 0) run.st().first_stable_ms = msSince(run.t0);
   // Nothing stable on a scan where trees ended lying on a roll: why, and what would help. Where a
   // nearly round object comes to rest about its axis is finer than a scan's noise (the marker:
-  // valleys 0.2 mm deep under 2 mm of noise; doc/method.md, "Closed scans").
+  // valleys 0.2 mm deep under 2 mm of noise; doc/method.md, "Nothing stable on a scan, said why").
   if (run.scanned() && run.result.stableCount() == 0 && search.rollsNotHeld() > 0) {
     char msg[320];
     std::snprintf(msg, sizeof msg,

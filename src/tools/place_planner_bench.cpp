@@ -1,8 +1,9 @@
 // Google Benchmark of the planner at the paper's workload (Section VII-C): about 140 floor
 // points, max 5 rotations, the mug decimated to 200, 500 and 1000 triangles, on books_stack
 // and dish_rack from ../shared/data; and planned on scans (../shared/data/scans: the mug seen from
-// above on books_stack seen from the robot's head, 20,000 triangles), as a robot plans. Counters: time to the first stable candidate, floor points,
-// tree nodes, stable candidates and time per batched step (ms). "cold" rebuilds the area's
+// above on books_stack seen from the robot's head, 20,000 triangles), as a robot plans. Counters:
+// time to the first stable candidate, floor points, tree nodes, stable candidates and time per
+// batched step (ms). "cold" rebuilds the area's
 // model every iteration; "warm" reuses it (a robot placing several objects on one area).
 //
 //   place_planner_bench --data ../shared/data [--benchmark_filter=...]

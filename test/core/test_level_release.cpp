@@ -138,6 +138,54 @@ TEST(LevelRelease, ACanOnItsSideRestsOnACurvedFace) {
   EXPECT_FALSE(restsOnCurvedFace(can, lying, line, wall, p));
 }
 
+// A tall can (a bottle's body) whose bottom a scan fused `askew_deg` off square to its side,
+// standing on that bottom, level on z = 0, with three contacts under it.
+struct AskewBottom {
+  Mesh can = scenes::cylinder(0.035, 0.2, 48);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3d> contacts = {{-0.025, -0.02, 0}, {0.025, -0.02, 0}, {0.0, 0.028, 0}};
+  std::vector<Eigen::Vector3d> up = std::vector<Eigen::Vector3d>(3, Eigen::Vector3d::UnitZ());
+  explicit AskewBottom(double askew_deg) {
+    double bottom = 1e9;
+    for (const auto& v : can.vertices) bottom = std::min(bottom, v.z());
+    for (auto& v : can.vertices)
+      if (v.z() < bottom + 1e-9) v.z() += v.x() * std::tan(askew_deg * M_PI / 180);
+    can.properties = computeProperties(can);
+    // Turned so that bottom lies level: its side then leans askew_deg.
+    X.linear() = Eigen::AngleAxisd(askew_deg * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    double low = 1e9;
+    for (const auto& v : can.vertices) low = std::min(low, (X * v).z());
+    X.translation().z() = -low;
+  }
+};
+
+// A scan's bottom 2 degrees askew: the can is turned upright, square to its side, not to that
+// bottom's plane (which lies level already); a bottom 8 degrees off square is the object's own
+// shape, not the scan's error, and is left as it rests.
+TEST(LevelRelease, TurnsAFaceSquareToItsWallsWithinTheScansTilt) {
+  const AskewBottom b(2.0);
+  ASSERT_GT(tiltDeg(b.X.linear()), 1.9) << "the side does not lean: the test would pass on nothing";
+  const LevelReleaseParams scan = levelReleaseParams(0.002, true);
+  ASSERT_TRUE(scan.square_to_walls);
+  const auto turn = levelingTurn(b.can, b.X, b.contacts, b.up, scan);
+  ASSERT_TRUE(turn.has_value()) << "a bottle stood 2 degrees off its axis was left so";
+  EXPECT_LT(tiltDeg((*turn * b.X).linear()), 0.2) << "its side not upright";
+  // The axis itself, and none where the face outweighs the walls (a plate's rim says less than
+  // its face).
+  std::vector<Eigen::Vector3d> v_G;
+  for (const auto& v : b.can.vertices) v_G.push_back(b.X * v);
+  const std::optional<Eigen::Vector3d> axis = wallAxis(b.can, v_G, Eigen::Vector3d(0, 0, -1), 0.0);
+  ASSERT_TRUE(axis.has_value());
+  EXPECT_LT(std::acos(std::clamp(axis->dot(b.X.linear() * Eigen::Vector3d(0, 0, -1)), -1.0, 1.0)) * 180 / M_PI, 0.01);
+  EXPECT_FALSE(wallAxis(b.can, v_G, Eigen::Vector3d(0, 0, -1), 1.0).has_value());
+  LevelReleaseParams face_only = scan;  // an exact mesh's: its face is exact
+  face_only.square_to_walls = false;
+  EXPECT_FALSE(levelingTurn(b.can, b.X, b.contacts, b.up, face_only).has_value()) << "the face is level already";
+  EXPECT_FALSE(levelReleaseParams(0.002, false).square_to_walls);
+  const AskewBottom cut(8.0);
+  EXPECT_FALSE(levelingTurn(cut.can, cut.X, cut.contacts, cut.up, scan).has_value()) << "8 degrees off square is its shape";
+}
+
 }  // namespace
 // A curved support of a scan is levelled on its strip's plane: a ring lying on a table 2 degrees
 // off its plane (a curved tube's roll about its chord, which a scan's noise sets a few degrees

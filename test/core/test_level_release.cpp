@@ -160,7 +160,7 @@ struct AskewBottom {
 };
 
 // A scan's bottom 2 degrees askew: the can is turned upright, square to its side, not to that
-// bottom's plane (which lies level already); a bottom 8 degrees off square is the object's own
+// bottom's plane (which lies level already); a bottom 12 degrees off square is the object's own
 // shape, not the scan's error, and is left as it rests.
 TEST(LevelRelease, TurnsAFaceSquareToItsWallsWithinTheScansTilt) {
   const AskewBottom b(2.0);
@@ -182,8 +182,14 @@ TEST(LevelRelease, TurnsAFaceSquareToItsWallsWithinTheScansTilt) {
   face_only.square_to_walls = false;
   EXPECT_FALSE(levelingTurn(b.can, b.X, b.contacts, b.up, face_only).has_value()) << "the face is level already";
   EXPECT_FALSE(levelReleaseParams(0.002, false).square_to_walls);
-  const AskewBottom cut(8.0);
-  EXPECT_FALSE(levelingTurn(cut.can, cut.X, cut.contacts, cut.up, scan).has_value()) << "8 degrees off square is its shape";
+  // Up to the tilt a scan's face may have (10 degrees: a face seen at a grazing angle bends by
+  // millimetres); past it, the object's own shape.
+  const AskewBottom bent(8.0);
+  const auto bent_turn = levelingTurn(bent.can, bent.X, bent.contacts, bent.up, scan);
+  ASSERT_TRUE(bent_turn.has_value());
+  EXPECT_LT(tiltDeg((*bent_turn * bent.X).linear()), 0.2);
+  const AskewBottom cut(12.0);
+  EXPECT_FALSE(levelingTurn(cut.can, cut.X, cut.contacts, cut.up, scan).has_value()) << "12 degrees off square is its shape";
 }
 
 }  // namespace

@@ -31,10 +31,10 @@ struct LevelReleaseParams {
   bool curved = true;                   // curved faces levelled too (a scan's; off: flat ones only)
   double contact_tol = 0.003;           // m: contacts this near one plane are a planar support
   double area_tol = 0.002;              // m: the area under the face is that plane within this
-  // A flat face is levelled square to the walls around it where they stand at right angles to it
-  // within wall_dev_deg (wallAxis): false, by its own plane only (an exact mesh's face is exact).
+  // A face (flat, or a scan's warped one) is levelled square to the walls around it where they
+  // stand square to one axis within max_tilt_deg of its normal (wallAxis): false, by its own
+  // plane only (an exact mesh's face is exact).
   bool square_to_walls = true;
-  double wall_dev_deg = 5.0;            // the walls' axis this near the face's normal: the face is square to them
 };
 
 // The planner's levelling parameters for a scan's noise (m): the support face within three times
@@ -50,10 +50,10 @@ LevelReleaseParams levelReleaseParams(double scan_noise, bool scanned);
 
 // The axis of the walls of `object_O` (vertices v_G, frame G) round a face of normal `face_n`:
 // the triangles within 20 degrees of square to the face, where their area outweighs the face's
-// (`face_area`), face several ways (not one wall) and turn round one line, their component along
-// it constant within 6 degrees r.m.s. (a can's or a bottle's body, a box's sides, a cone's
-// taper; not a bowl's curve or a scan's warped flare). Then that line (the least eigenvector of
-// the covariance of their normals, by area), turned along face_n. None otherwise.
+// (`face_area`), face two ways at least (not one wall) and stand square to one line within 6
+// degrees r.m.s. (a can's or a bottle's body, a box's or a prism's sides; not a bowl's curve, a
+// cone's taper or a scan's warped flare). Then that line (the least eigenvector of their normals'
+// area-weighted scatter), turned along face_n. None otherwise.
 std::optional<Eigen::Vector3d> wallAxis(const Mesh& object_O, const std::vector<Eigen::Vector3d>& v_G,
                                         const Eigen::Vector3d& face_n, double face_area);
 
@@ -63,12 +63,14 @@ std::optional<Eigen::Vector3d> wallAxis(const Mesh& object_O, const std::vector<
 // it: a face resting on a plane, not a lean). None when the contacts are not such a plane, the
 // face is smaller than min_face_area, or curved (max_curve_deg) with `curved` off, or its tilt
 // lies outside [min_tilt_deg, max_tilt_deg]. A curved face is cut again by its own plane until
-// the cut holds still. A flat face whose walls' axis (wallAxis) lies within wall_dev_deg of its
-// normal is turned so that axis is square to P instead (square_to_walls): a scan sees a bottle's
-// bottom obliquely, a few triangles fused 1-2 degrees askew, while its body's hundreds of
-// triangles say where its axis is, and a made thing's bottom is square to its sides (the held-out
-// bottle seen in the hand stood 2.2 degrees off its axis, its bottom's plane 0.8 degrees off
-// that, and Bullet spun the true bottle 5-29 degrees about its axis as it landed on its edge).
+// the cut holds still. A face, flat or curved, whose walls' axis (wallAxis) lies within
+// max_tilt_deg of its normal is turned so that axis is square to P instead (square_to_walls): a
+// scan sees a bottle's bottom obliquely, a few triangles fused 1-2 degrees askew, while its body's
+// hundreds of triangles say where its axis is, and a made thing's bottom is square to its sides
+// (the held-out bottle seen in the hand stood 2.2 degrees off its axis, its bottom's plane 0.8
+// degrees off that, and Bullet spun the true bottle 5-29 degrees about its axis as it landed on
+// its edge; a wedge seen from above lay on its side, warped 5-6 degrees and so taken as curved,
+// and Bullet turned it 5-6 degrees).
 // Only where the area under the face is that plane too: under each sample of the face (up to
 // 16) that lies over area triangles facing along P within 60 degrees, one with its corners
 // within area_tol of P, and at least three in four samples so (a table, a board, up to a scan's

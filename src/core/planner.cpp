@@ -712,15 +712,20 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
                        std::vector<Candidate>& candidates) {
   const LevelReleaseParams lp = levelReleaseParams(config.scan_noise, scanned);
   if (lp.band <= 0) return;
+  LevelReleaseParams walls_only = lp;
+  walls_only.walls_only = true;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
   X_GW.linear() = m.am->R_GW;
   std::vector<Eigen::Vector3d> p, n;
   for (Candidate& c : candidates) {
-    // On a cap the face is the completion's guess, not the scan's (the cap's own lift, below).
-    if (c.hanging || !c.stable || c.support != SupportKind::kSeen) continue;
+    if (c.hanging || !c.stable) continue;
+    // On a cap the face is the completion's guess, and at the area scan's border the area under
+    // it is partly unseen: only the seen walls square it (the cap's own lift follows, below).
+    if (c.support != SupportKind::kSeen && !lp.square_to_walls) continue;
     const Eigen::Isometry3d X_GO = X_GW * c.X_WO;
     contactsInG(c, X_GW, p, n);
-    const std::optional<Eigen::Isometry3d> turn = levelingTurn(object_O, X_GO, p, n, lp, m.am.get());
+    const std::optional<Eigen::Isometry3d> turn =
+        levelingTurn(object_O, X_GO, p, n, c.support == SupportKind::kSeen ? lp : walls_only, m.am.get());
     if (!turn) continue;
     Rigid Y = toRigid(*turn * X_GO);
     const std::optional<V3> out = clearingShift(m.om, *m.am, Y, kResultClearance, lp.band);

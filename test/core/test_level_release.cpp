@@ -190,6 +190,21 @@ TEST(LevelRelease, TurnsAFaceSquareToItsWallsWithinTheScansTilt) {
   EXPECT_LT(tiltDeg((*bent_turn * bent.X).linear()), 0.2);
   const AskewBottom cut(12.0);
   EXPECT_FALSE(levelingTurn(cut.can, cut.X, cut.contacts, cut.up, scan).has_value()) << "12 degrees off square is its shape";
+  // On a cap (a guess) only the walls square it: a disc's rim, smaller than its face, does not.
+  LevelReleaseParams walls_only = scan;
+  walls_only.walls_only = true;
+  const auto capped = levelingTurn(b.can, b.X, b.contacts, b.up, walls_only);
+  ASSERT_TRUE(capped.has_value());
+  EXPECT_LT(tiltDeg((*capped * b.X).linear()), 0.2);
+  const TiltedCan can;  // 8 cm across, 10 cm tall, 2 degrees off: its side outweighs its bottom
+  EXPECT_TRUE(levelingTurn(can.can, can.X, can.contacts, can.up, walls_only).has_value());
+  const Mesh plate = scenes::cylinder(0.04, 0.004, 48);  // 4 mm tall
+  Eigen::Isometry3d X = can.X;
+  double low = 1e9;
+  for (const auto& v : plate.vertices) low = std::min(low, (X * v).z());
+  X.translation().z() -= low;
+  EXPECT_TRUE(levelingTurn(plate, X, can.contacts, can.up, scan).has_value()) << "by its face";
+  EXPECT_FALSE(levelingTurn(plate, X, can.contacts, can.up, walls_only).has_value()) << "its rim is no wall";
 }
 
 }  // namespace

@@ -35,6 +35,8 @@ struct LevelReleaseParams {
   // stand square to one axis within max_tilt_deg of its normal (wallAxis): false, by its own
   // plane only (an exact mesh's face is exact).
   bool square_to_walls = true;
+  // Only square to the walls: none where they define no axis (a face that is a guess: a cap).
+  bool walls_only = false;
 };
 
 // The planner's levelling parameters for a scan's noise (m): the support face within three times

@@ -221,7 +221,9 @@ std::optional<Eigen::Isometry3d> levelingTurn(const Mesh& object_O, const Eigen:
   if (params.square_to_walls) {
     const std::optional<Eigen::Vector3d> axis = wallAxis(object_O, sf->v, F.normal, sf->face_area);
     if (axis && axis->dot(F.normal) >= std::cos(params.max_tilt_deg * M_PI / 180.0)) n_face = *axis;
+    else if (params.walls_only) return std::nullopt;
   }
+  if (params.walls_only && !params.square_to_walls) return std::nullopt;
   const double tilt = std::acos(std::clamp(n_face.dot(P.normal), -1.0, 1.0));
   if (tilt < params.min_tilt_deg * M_PI / 180.0 || tilt > params.max_tilt_deg * M_PI / 180.0) return std::nullopt;
   if (area_G && !flatUnder(*area_G, pts, P, params.area_tol)) return std::nullopt;

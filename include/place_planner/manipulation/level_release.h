@@ -33,7 +33,7 @@ struct LevelReleaseParams {
   double area_tol = 0.002;              // m: the area under the face is that plane within this
   // A face (flat, or a scan's warped one) is levelled square to the walls around it where they
   // stand square to one axis within max_tilt_deg of its normal (wallAxis): false, by its own
-  // plane only (an exact mesh's face is exact).
+  // plane only (an exact mesh's face is exact; the planner squares open scans only).
   bool square_to_walls = true;
   // Only square to the walls: none where they define no axis (a face that is a guess: a cap).
   bool walls_only = false;

@@ -47,7 +47,8 @@ struct LevelReleaseParams {
 // A curved support is levelled on a scan only (`scanned`, a closed one too with closed_scan): on
 // an exact mesh a curved rest is tilted from its strip's plane by the shape itself (the marker's
 // cap: 1.3-3 degrees), and levelled there Bullet turned the 1k marker 19 degrees in the divided
-// tray.
+// tray. Squared to its walls on a scan only too (square_to_walls; the planner turns it off for a
+// closed one, whose faces were seen as well as its walls).
 LevelReleaseParams levelReleaseParams(double scan_noise, bool scanned);
 
 // The axis of the walls of `object_O` (vertices v_G, frame G) round a face of normal `face_n`:

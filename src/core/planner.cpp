@@ -710,13 +710,8 @@ void contactsInG(const Candidate& c, const Eigen::Isometry3d& X_GW, std::vector<
 // out of the area where the turn took part of it in (clearingShift), or left as it was.
 void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfig& config, bool scanned,
                        bool open, std::vector<Candidate>& candidates) {
-  LevelReleaseParams lp = levelReleaseParams(config.scan_noise, scanned);
+  const LevelReleaseParams lp = levelReleaseParams(config.scan_noise, scanned, open);
   if (lp.band <= 0) return;
-  // Squared to its walls on an open scan only: a face beside what the camera never saw was seen
-  // obliquely, if at all; a closed scan's faces were seen as well as its walls (a YCB pudding box
-  // squared to its scanned sides stood 1.3 degrees off the face it rests on, and Bullet turned
-  // it 5 degrees back).
-  lp.square_to_walls = lp.square_to_walls && open;
   LevelReleaseParams walls_only = lp;
   walls_only.walls_only = true;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();

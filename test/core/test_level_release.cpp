@@ -165,7 +165,7 @@ struct AskewBottom {
 TEST(LevelRelease, TurnsAFaceSquareToItsWallsWithinTheScansTilt) {
   const AskewBottom b(2.0);
   ASSERT_GT(tiltDeg(b.X.linear()), 1.9) << "the side does not lean: the test would pass on nothing";
-  const LevelReleaseParams scan = levelReleaseParams(0.002, true);
+  const LevelReleaseParams scan = levelReleaseParams(0.002, true, true);  // an open scan's
   ASSERT_TRUE(scan.square_to_walls);
   const auto turn = levelingTurn(b.can, b.X, b.contacts, b.up, scan);
   ASSERT_TRUE(turn.has_value()) << "a bottle stood 2 degrees off its axis was left so";
@@ -182,6 +182,7 @@ TEST(LevelRelease, TurnsAFaceSquareToItsWallsWithinTheScansTilt) {
   face_only.square_to_walls = false;
   EXPECT_FALSE(levelingTurn(b.can, b.X, b.contacts, b.up, face_only).has_value()) << "the face is level already";
   EXPECT_FALSE(levelReleaseParams(0.002, false).square_to_walls);
+  EXPECT_FALSE(levelReleaseParams(0.002, true, false).square_to_walls) << "a closed scan's faces were seen";
   // Up to the tilt a scan's face may have (10 degrees: a face seen at a grazing angle bends by
   // millimetres); past it, the object's own shape.
   const AskewBottom bent(8.0);

@@ -33,7 +33,7 @@ struct LevelReleaseParams {
   double area_tol = 0.002;              // m: the area under the face is that plane within this
   // A face (flat, or a scan's warped one) is levelled square to the walls around it where they
   // stand square to one axis within max_tilt_deg of its normal (wallAxis): false, by its own
-  // plane only (an exact mesh's face is exact; the planner squares open scans only).
+  // plane only (an exact mesh's face is exact; levelReleaseParams: open scans only).
   bool square_to_walls = true;
   // Only square to the walls: none where they define no axis (a face that is a guess: a cap).
   bool walls_only = false;
@@ -47,9 +47,11 @@ struct LevelReleaseParams {
 // A curved support is levelled on a scan only (`scanned`, a closed one too with closed_scan): on
 // an exact mesh a curved rest is tilted from its strip's plane by the shape itself (the marker's
 // cap: 1.3-3 degrees), and levelled there Bullet turned the 1k marker 19 degrees in the divided
-// tray. Squared to its walls on a scan only too (square_to_walls; the planner turns it off for a
-// closed one, whose faces were seen as well as its walls).
-LevelReleaseParams levelReleaseParams(double scan_noise, bool scanned);
+// tray. Squared to its walls on an open scan only (`open`, capped by the completion:
+// square_to_walls): a face beside what the camera never saw was seen obliquely, if at all, while
+// a closed scan's faces were seen as well as its walls (a YCB pudding box squared to its scanned
+// sides stood 1.3 degrees off the face it rests on, and Bullet turned it 5 degrees back).
+LevelReleaseParams levelReleaseParams(double scan_noise, bool scanned, bool open = false);
 
 // The axis of the walls of `object_O` (vertices v_G, frame G) round a face of normal `face_n`:
 // the triangles within 20 degrees of square to the face, where their area outweighs the face's

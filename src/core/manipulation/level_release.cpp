@@ -182,12 +182,12 @@ std::optional<Eigen::Vector3d> wallAxis(const Mesh& object_O, const std::vector<
   return a.dot(face_n) < 0 ? Eigen::Vector3d(-a) : a;
 }
 
-LevelReleaseParams levelReleaseParams(double scan_noise, bool scanned) {
+LevelReleaseParams levelReleaseParams(double scan_noise, bool scanned, bool open) {
   LevelReleaseParams lp;
   lp.band = 3.0 * scan_noise;
   lp.area_tol = 2.0 * scan_noise;
   lp.curved = scanned;
-  lp.square_to_walls = scanned;
+  lp.square_to_walls = scanned && open;
   return lp;
 }
 

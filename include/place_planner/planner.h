@@ -93,7 +93,8 @@ struct Candidate {
   bool hanging = false;
   // What carries it (model/completion.h): kSeen, or surface the scans never saw: kCompleted (a
   // contact on a cap over an open region of the object) or kAreaBorder (a contact at the border
-  // of what the area's scan saw). Those rank after every stable pose on seen surface.
+  // of what the area's scan saw). Those are offered as stable only where no pose on seen
+  // surface holds (then flagged, after the seen ones in rank; PlanStats::unseen_withheld).
   SupportKind support = SupportKind::kSeen;
   bool completed_support() const { return support != SupportKind::kSeen; }
   // A scanned object resting on a curved face of its scan (a can on its side, a rounded rim:
@@ -139,6 +140,7 @@ struct PlanStats {
   int robustness_rejected = 0;     // ... found not robust (returned as not stable)
   int gripper_rejected = 0;        // candidates the gripper blocks (dropped unless keep_colliding)
   int gripper_tilt_rejected = 0;   // leaves whose gripper would point over max_gripper_tilt_deg
+  int unseen_withheld = 0;         // distinct statically stable poses on unseen surface not offered: one on seen surface holds
   int floor_points_total = 0;
   int floor_points_done = 0;
   long tree_nodes = 0;             // poses evaluated over all trees

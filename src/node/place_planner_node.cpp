@@ -328,6 +328,7 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   result.trees_without_rest = plan.stats.trees_without_rest;
   result.gripper_rejected = plan.stats.gripper_rejected;
   result.gripper_tilt_rejected = plan.stats.gripper_tilt_rejected;
+  result.unseen_withheld = plan.stats.unseen_withheld;
   result.objects_in_area = placed_.count;
   result.partial = false;
   const int n_stable = plan.stableCount();
@@ -335,6 +336,8 @@ void PlacePlannerNode::plan(const PlacePlanGoal& goal, Answer* answer) {
   summary << plan.candidates.size() << " candidates (" << n_stable << " stable) from " << searchedRoots(plan.stats);
   summary << " in " << (ros::WallTime::now() - plan_start_).toSec() << " s"
           << physics_summary;
+  if (plan.stats.unseen_withheld > 0)
+    summary << "; " << plan.stats.unseen_withheld << " poses on unseen surface withheld (a pose on seen surface holds)";
   if (prepared.config.has_grasp) {
     summary << "; gripper: " << plan.stats.gripper_rejected << " candidates blocked, "
             << plan.stats.gripper_tilt_rejected << " poses tilted over max_gripper_tilt_deg";

@@ -256,6 +256,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
   j["warnings"] = r.warnings;
   j["gripper_rejected"] = st.gripper_rejected;
   j["gripper_tilt_rejected"] = st.gripper_tilt_rejected;
+  j["unseen_withheld"] = st.unseen_withheld;  // stable on unseen surface, not offered: a seen pose holds
   Json candidates = Json::array();
   for (const auto& k : r.candidates) {
     Json contacts = Json::array();
@@ -339,6 +340,9 @@ void printReport(const std::string& object_spec, const Mesh& object, const std::
     std::printf("trees: %d cut by max_rotations while still tilting, %d ended at the bottom of a roll, "
                 "%d cut while falling over a ledge\n",
                 st.trees_without_rest, st.roll_bottoms, st.trees_fallen);
+  if (st.unseen_withheld > 0)
+    std::printf("support: %d stable poses on surface the scans never saw withheld (a pose on seen surface holds)\n",
+                st.unseen_withheld);
   std::printf("steps [ms]: setup %.1f, floor points %.1f, distance %.1f, contacts %.1f, vertex/surface %.1f, "
               "edge/edge %.1f, stability %.1f, local optimisation %.1f, robustness %.1f\n",
               st.steps.setup, st.steps.floor_points, st.steps.first_contact, st.steps.contact_points,

@@ -341,7 +341,7 @@ void printReport(const std::string& object_spec, const Mesh& object, const std::
                 "%d cut while falling over a ledge\n",
                 st.trees_without_rest, st.roll_bottoms, st.trees_fallen);
   if (st.unseen_withheld > 0)
-    std::printf("support: %d stable poses on surface the scans never saw withheld (a pose on seen surface holds)\n",
+    std::printf("support: %d statically stable poses on surface the scans never saw not offered (a pose on seen surface holds)\n",
                 st.unseen_withheld);
   std::printf("steps [ms]: setup %.1f, floor points %.1f, distance %.1f, contacts %.1f, vertex/surface %.1f, "
               "edge/edge %.1f, stability %.1f, local optimisation %.1f, robustness %.1f\n",

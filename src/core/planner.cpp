@@ -741,21 +741,77 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
 // face: where on a curved face the true object comes to rest is finer than the scan (Bullet
 // rolled the held-out can, planned lying on its in-hand scan, by 18 degrees), while a flat face
 // holds whatever the scan's noise (doc/method.md, "Curved supports after flat ones").
-void curvedSupportsLast(const Mesh& object_O, const Eigen::Matrix3d& R_GW, const PlannerConfig& config,
-                        std::vector<Candidate>& candidates) {
+//
+// And beyond a cap (unseen is not empty there either): the part a scan never saw may reach past
+// its cap, so a pose whose cap faces a wall of the area within the cap's own size (at least
+// scan_unseen_reach) may put that part into it. Rays along the cap's outward normal turned
+// horizontal (G), from its middle and from points 0.8 of the way to its rim, lifted 1 mm against
+// gravity: the floor the object rests on is no wall. A cap facing more up or down than sideways
+// is not tested (down: it carries the object, onCompletedSurface's; up: open space). A hit marks
+// the pose, ranked after the other seen ones. (The held-out hexagonal prism seen in the hand, its
+// hidden end 3 cm from the bin's wall: its true end reaches 2.3 cm past the cap, and Bullet
+// pushed it 2 cm back.)
+bool capFacesTheArea(const Completion& completion, const AreaModel& am, const Eigen::Isometry3d& X_GO, double reach_min) {
+  const BvhView view = am.triangle_bvh.nodes.empty()
+                           ? BvhView{nullptr, nullptr, 0}
+                           : BvhView{am.triangle_bvh.nodes.data(), am.triangle_bvh.order.data(),
+                                     static_cast<int>(am.triangle_bvh.nodes.size())};
+  for (const CompletionCap& cap : completion.caps) {
+    double radius = 0;
+    for (const Eigen::Vector3d& q : cap.loop) radius = std::max(radius, (q - cap.centroid).norm());
+    const double reach = std::max(reach_min, radius);
+    Eigen::Vector3d out = X_GO.linear() * cap.normal;
+    out.z() = 0;
+    if (out.norm() < std::sqrt(0.5)) continue;  // facing more up or down than sideways
+    const V3 d = toV3(out.normalized());
+    std::vector<Eigen::Vector3d> from{cap.centroid};
+    const size_t step = std::max<size_t>(1, cap.loop.size() / 16);
+    for (size_t i = 0; i < cap.loop.size(); i += step) from.push_back(cap.centroid + 0.8 * (cap.loop[i] - cap.centroid));
+    for (const Eigen::Vector3d& q : from) {
+      const V3 o = toV3(X_GO * q) + v3(0, 0, 0.001);
+      const double t = bvhRay(view, o, d, reach, [&](int k) {
+        const auto& tri = am.triangles[k];
+        return rayTriangle(o, d, am.vertices[tri[0]], am.vertices[tri[1]], am.vertices[tri[2]]);
+      });
+      if (t < reach) return true;
+    }
+  }
+  return false;
+}
+
+void curvedSupportsLast(const Mesh& object_O, const Completion& completion, const AreaModel& am,
+                        const PlannerConfig& config, std::vector<Candidate>& candidates) {
   const LevelReleaseParams lp = levelReleaseParams(config.scan_noise, true);  // the support face as levelOnTheSupport takes it
   if (lp.band <= 0) return;
   Eigen::Isometry3d X_GW = Eigen::Isometry3d::Identity();
-  X_GW.linear() = R_GW;
+  X_GW.linear() = am.R_GW;
   std::vector<Eigen::Vector3d> p, n;
-  for (Candidate& c : candidates) {
-    if (c.hanging || !c.stable || c.support != SupportKind::kSeen) continue;
+  std::vector<int> group(candidates.size(), 0);
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    Candidate& c = candidates[i];
+    if (!c.stable) {
+      group[i] = 4;
+      continue;
+    }
+    if (c.support != SupportKind::kSeen) {
+      group[i] = 3;
+      continue;
+    }
+    if (c.hanging) continue;
     contactsInG(c, X_GW, p, n);
     c.curved_support = restsOnCurvedFace(object_O, X_GW * c.X_WO, p, n, lp);
+    group[i] = c.curved_support ? 1 : 0;
+    if (completion.completed() && capFacesTheArea(completion, am, X_GW * c.X_WO, config.scan_unseen_reach)) group[i] = 2;
   }
-  // Stable on a flat seen face; stable on a curved one; stable on unseen surface; the rest.
-  auto group = [](const Candidate& c) { return !c.stable ? 3 : c.support != SupportKind::kSeen ? 2 : c.curved_support ? 1 : 0; };
-  stableSortAligned(candidates, [&](const Candidate& a, const Candidate& b) { return group(a) < group(b); });
+  // Stable on a flat seen face; on a curved one; with a cap facing the area; stable on unseen
+  // surface; the rest.
+  std::vector<size_t> order(candidates.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return group[a] < group[b]; });
+  std::vector<Candidate> sorted;
+  sorted.reserve(candidates.size());
+  for (size_t i : order) sorted.push_back(std::move(candidates[i]));
+  candidates.swap(sorted);
 }
 
 }  // namespace
@@ -842,7 +898,7 @@ PlanResult Planner::planOnce(const Mesh& object, const Mesh& area, const Planner
                  run.result.candidates);
   levelOnTheSupport(*models, models->searched(run.object), config, run.scanned(), completion.completed(),
                     run.result.candidates);
-  if (run.scanned()) curvedSupportsLast(models->searched(run.object), models->am->R_GW, config, run.result.candidates);
+  if (run.scanned()) curvedSupportsLast(models->searched(run.object), completion, *models->am, config, run.result.candidates);
   // A scanned object resting on a cap: its unseen part may reach below the cap, so it is
   // released higher by the scan's noise or by how far the unseen may reach, whichever is more
   // (config.h scan_unseen_reach), with its path and pre-place pose. A hanging one is raised by

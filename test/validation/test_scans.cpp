@@ -268,6 +268,67 @@ TEST(Scans, AClosedMeshWithNoRestWithinItsNoiseIsPlannedAgainAsExact) {
   EXPECT_LT((best(e)->X_WO.translation() - b->X_WO.translation()).norm(), 1e-6) << "not the exact plan's pose";
 }
 
+// A bar seen in the hand: its +x end never seen (the hand's), capped. The true bar is 3 cm
+// longer there. In a bin, a pose whose open end faces a wall within the cap's size (at least
+// scan_unseen_reach) may put the unseen part into the wall: such poses rank after the seen ones
+// that face open space, and the best pose holds on the true bar in Bullet.
+TEST(Scans, AnOpenEndFacingTheAreaRanksAfterOneFacingAway) {
+  const Mesh bar = scenes::box(0.16, 0.04, 0.04);
+  std::vector<std::vector<int>> polygons;
+  for (size_t i = 0; i < bar.patches.size(); ++i)
+    if (bar.patch_normals[i].x() < 0.9) polygons.push_back(bar.patches[i]);
+  const Mesh scan = buildMesh(bar.vertices, polygons, "bar seen in the hand");
+  const Mesh truth = scenes::box(0.19, 0.04, 0.04, Eigen::Vector3d(0.015, 0, 0));
+  const Mesh bin = scenes::openBox();
+  PlannerConfig cfg;
+  cfg.threads = 2;
+  cfg.max_candidates = 20;
+  const PlanResult r = Planner().plan(scan, bin, cfg);
+  // The open end faces the bin's wall within reach: rays along +x (O) turned horizontal, 1 mm up,
+  // from the end's middle and from 0.8 of the way to each corner; reach: the cap's size, its
+  // middle to a corner.
+  auto hits = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d, double reach) {
+    for (const auto& t : bin.triangles) {
+      const Eigen::Vector3d a = bin.vertices[t[0]], e1 = bin.vertices[t[1]] - a, e2 = bin.vertices[t[2]] - a;
+      const Eigen::Vector3d h = d.cross(e2);
+      const double det = e1.dot(h);
+      if (std::abs(det) < 1e-12) continue;
+      const Eigen::Vector3d s = o - a;
+      const double u = s.dot(h) / det, v = d.dot(s.cross(e1)) / det, dist = e2.dot(s.cross(e1)) / det;
+      if (u >= 0 && v >= 0 && u + v <= 1 && dist > 0 && dist < reach) return true;
+    }
+    return false;
+  };
+  auto faces = [&](const Candidate& c) {
+    Eigen::Vector3d d = c.X_WO.linear() * Eigen::Vector3d::UnitX();
+    d.z() = 0;  // a wall, not the floor it rests on
+    if (d.norm() < std::sqrt(0.5)) return false;
+    d.normalize();
+    const double reach = std::max(cfg.scan_unseen_reach, std::hypot(0.02, 0.02));
+    for (const Eigen::Vector3d& q : {Eigen::Vector3d(0.08, 0, 0), Eigen::Vector3d(0.08, 0.016, 0.016),
+                                     Eigen::Vector3d(0.08, -0.016, 0.016), Eigen::Vector3d(0.08, 0.016, -0.016),
+                                     Eigen::Vector3d(0.08, -0.016, -0.016)})
+      if (hits(c.X_WO * q + Eigen::Vector3d(0, 0, 0.001), d, reach)) return true;
+    return false;
+  };
+  int facing = 0, clear = 0;
+  for (const auto& c : r.candidates) {
+    if (!c.stable || c.support != SupportKind::kSeen || c.curved_support) continue;
+    if (faces(c)) ++facing;
+    else {
+      EXPECT_EQ(facing, 0) << "a pose facing open space ranked after one whose open end faces the bin";
+      ++clear;
+    }
+  }
+  ASSERT_GT(clear, 0) << "no seen pose facing open space";
+  EXPECT_GT(facing, 0) << "no pose's open end faces the bin: the test shows nothing";
+  const Candidate* c = best(r);
+  ASSERT_NE(c, nullptr);
+  EXPECT_FALSE(faces(*c));
+  const auto check = bullet(truth, bin, *c, cfg.friction);
+  EXPECT_TRUE(check.confirmed) << "moved " << check.moved_m << " m, turned " << check.turned_deg << " deg";
+}
+
 // With its sides seen, the box may stand on its completed bottom: allowed (stable), flagged.
 TEST(Scans, BoxStandingOnItsCompletedBottomIsAllowedAndFlagged) {
   const Mesh box = scenes::box(0.08, 0.06, 0.04);

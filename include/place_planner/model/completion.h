@@ -7,8 +7,8 @@
 //     its unseen part below the area's surface, and the centre of mass (from the surface) moves
 //     toward the unseen side as it should;
 //   - a pose whose contacts lie on a cap (inside it, farther than `margin` from the seen rim) needs
-//     surface that was not seen: it is flagged (Candidate::support) and ranked after every stable
-//     pose on seen surface (ranking.h).
+//     surface that was not seen: it is flagged (Candidate::support), and offered as stable only
+//     where no pose on seen surface holds (ranking.h).
 // Frame: the object's own frame O throughout.
 #pragma once
 #include <Eigen/Core>

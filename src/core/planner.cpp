@@ -752,10 +752,7 @@ void levelOnTheSupport(const Models& m, const Mesh& object_O, const PlannerConfi
 // hidden end 3 cm from the bin's wall: its true end reaches 2.3 cm past the cap, and Bullet
 // pushed it 2 cm back.)
 bool capFacesTheArea(const Completion& completion, const AreaModel& am, const Eigen::Isometry3d& X_GO, double reach_min) {
-  const BvhView view = am.triangle_bvh.nodes.empty()
-                           ? BvhView{nullptr, nullptr, 0}
-                           : BvhView{am.triangle_bvh.nodes.data(), am.triangle_bvh.order.data(),
-                                     static_cast<int>(am.triangle_bvh.nodes.size())};
+  const BvhView tris = view(am.triangle_bvh);
   for (const CompletionCap& cap : completion.caps) {
     double radius = 0;
     for (const Eigen::Vector3d& q : cap.loop) radius = std::max(radius, (q - cap.centroid).norm());
@@ -769,7 +766,7 @@ bool capFacesTheArea(const Completion& completion, const AreaModel& am, const Ei
     for (size_t i = 0; i < cap.loop.size(); i += step) from.push_back(cap.centroid + 0.8 * (cap.loop[i] - cap.centroid));
     for (const Eigen::Vector3d& q : from) {
       const V3 o = toV3(X_GO * q) + v3(0, 0, 0.001);
-      const double t = bvhRay(view, o, d, reach, [&](int k) {
+      const double t = bvhRay(tris, o, d, reach, [&](int k) {
         const auto& tri = am.triangles[k];
         return rayTriangle(o, d, am.vertices[tri[0]], am.vertices[tri[1]], am.vertices[tri[2]]);
       });

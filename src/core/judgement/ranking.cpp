@@ -265,12 +265,11 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
       }
   // Push resistance of the stable candidates to be returned (bounded: max_candidates of them),
   // from the contacts in cells of a tenth of the object's radius; they are ranked again with it.
-  const auto& returned = offered;
   const ForceModelParams forces{config.friction, 8, 3.0};
   std::vector<Item*> to_push;
   for (Item& it : distinct) {
     if (static_cast<int>(to_push.size()) >= config.max_candidates) break;
-    if (returned(it) && it.stable) to_push.push_back(&it);
+    if (offered(it) && it.stable) to_push.push_back(&it);
   }
   // One small LP per direction and candidate, each candidate on its own: over the threads.
   parallelFor(to_push.size(), config.threads, [&](size_t k) {
@@ -283,7 +282,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
   sortItems(distinct, leaves);
   for (const Item& it : distinct) {
     if (static_cast<int>(out.size()) >= config.max_candidates) break;
-    if (!returned(it)) continue;
+    if (!offered(it)) continue;
     const TreeLeaf& l = leaves[it.leaf];
     Candidate c;
     const Eigen::Isometry3d X_GO = toIsometry(l.X_GO);

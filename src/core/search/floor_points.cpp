@@ -30,10 +30,7 @@ struct RayFrame {
 std::vector<V3> castGrid(const AreaModel& area, const FloorPointParams& p, const RayFrame& f, double spacing,
                          const StopSignal* stop) {
   const V3 d = f.d;
-  const auto view = area.triangle_bvh.nodes.empty() ? BvhView{nullptr, nullptr, 0}
-                                                    : BvhView{area.triangle_bvh.nodes.data(),
-                                                              area.triangle_bvh.order.data(),
-                                                              static_cast<int>(area.triangle_bvh.nodes.size())};
+  const BvhView tris = view(area.triangle_bvh);
   const int nu = f.nu(spacing), nw = f.nw(spacing);
   // Centre the grid on the area.
   const double u0 = 0.5 * (f.umin + f.umax) - 0.5 * (nu - 1) * spacing;
@@ -43,7 +40,7 @@ std::vector<V3> castGrid(const AreaModel& area, const FloorPointParams& p, const
     if (stop) stop->throwIfRequested();
     for (int i = 0; i < nu; ++i) {
       const V3 o = (u0 + i * spacing) * f.u + (w0 + j * spacing) * f.w + (f.hmin - 0.01) * d;
-      const double t = bvhRay(view, o, d, kInf, [&](int k) {
+      const double t = bvhRay(tris, o, d, kInf, [&](int k) {
         const auto& tri = area.triangles[k];
         return rayTriangle(o, d, area.vertices[tri[0]], area.vertices[tri[1]], area.vertices[tri[2]]);
       });

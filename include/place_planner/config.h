@@ -3,6 +3,7 @@
 #pragma once
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -72,6 +73,12 @@ struct PlannerConfig {
   bool rock_settle = true;
   double time_budget_ms = 0.0;               // 0 = no budget
   int max_candidates = 10;                   // after ranking and merging
+  // The search's and the ranking's work is sized for at least kMinRankedCandidates, whatever
+  // max_candidates: the first k candidates of an answer are the default answer's first k
+  // (k <= 10), so a robot asking for the one best pose gets the default's best, not a worse
+  // one or none (the robustness checks, bounded per candidate, stopped before it was reached).
+  static constexpr int kMinRankedCandidates = 10;
+  int rankedCandidates() const { return std::max(max_candidates, kMinRankedCandidates); }
   int threads = 0;                           // 0 = all hardware threads
   int max_local_optimisation_steps = 8;      // slides/rotations per leaf (Section VI)
   double min_support_width = 0.0;            // m, narrower support polygons do not hold (0 = off)

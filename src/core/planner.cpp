@@ -284,10 +284,10 @@ struct SearchMonitor {
     fresh.erase(std::remove_if(fresh.begin(), fresh.end(), [&](size_t i) { return !all[i].stable; }), fresh.end());
     // Until a robust stable pose is found, the new stable leaves are checked at once, in chunks
     // that double while none holds (1, 2, 4, 8: many trials in flight where poses keep failing,
-    // as on peg tops; one check where the first holds). Bounded work: after 2 x max_candidates
+    // as on peg tops; one check where the first holds). Bounded work: after 2 x rankedCandidates()
     // checks without one, the ranking checks the best of the rest (it would check them anyway).
     size_t j = 0;
-    const size_t max_checks = 2 * static_cast<size_t>(config.max_candidates);
+    const size_t max_checks = 2 * static_cast<size_t>(config.rankedCandidates());
     while (j < fresh.size() && st.first_stable_ms < 0 && config.robust_check && checked.size() < max_checks) {
       const size_t n = std::min({fresh.size() - j, chunk, max_checks - checked.size()});
       const std::vector<size_t> batch(fresh.begin() + j, fresh.begin() + j + n);

@@ -93,6 +93,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
                                       const RobustnessCheck& check, PlanStats* stats,
                                       const PlacementCheck& place) {
   const auto& leaves = in.leaves;
+  const int ranked = config.rankedCandidates();  // checked and ranked; max_candidates returned
   std::vector<Item> items;
   const Eigen::Vector3d near_G = in.R_GW * config.prefer_near;
   for (size_t i = 0; i < leaves.size(); ++i) {
@@ -149,14 +150,14 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
   auto placeable = [&](Item& it) {
     if (!place || it.placement.checked) return it.placement.blocked.empty();
     // Bounded work: when the gripper blocks pose after pose, the search for more stops.
-    if (++place_checks > 10L * config.max_candidates) return false;
+    if (++place_checks > 10L * ranked) return false;
     it.placement = place(it.leaf);
     if (it.placement.blocked.empty()) return true;
     if (stats) ++stats->gripper_rejected;
     it.stable = false;
     return false;
   };
-  // Robustness, best stable first, until max_candidates robust ones are found.
+  // Robustness, best stable first, until rankedCandidates() robust ones are found.
   if (config.robust_check && check) {
     // A leaf's robustness decides its stable flag; true when it holds.
     auto record = [&](Item& it, const Robustness& r) {
@@ -184,8 +185,8 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
              std::any_of(failed_down.begin(), failed_down.end(), [&](const V3& f) { return dot(d, f) > same_face; });
     };
     std::vector<bool> tried(distinct.size(), false);
-    // Bounded work: at most four times max_candidates leaves are checked.
-    while (robust < config.max_candidates && checked < 4L * config.max_candidates) {
+    // Bounded work: at most four times rankedCandidates() leaves are checked.
+    while (robust < ranked && checked < 4L * ranked) {
       // The best stable leaves not tried yet: on seen surface first, then not on a failing face.
       std::vector<std::pair<int, size_t>> order;  // (2 * unseen + failing, rank)
       for (size_t k = 0; k < distinct.size(); ++k)
@@ -195,7 +196,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
                        [](const auto& a, const auto& b) { return a.first < b.first; });
       std::vector<size_t> batch, where;
       for (const auto& [group, k] : order) {
-        if (batch.size() >= static_cast<size_t>(config.max_candidates - robust)) break;
+        if (batch.size() >= static_cast<size_t>(ranked - robust)) break;
         tried[k] = true;
         if (placeable(distinct[k])) {
           batch.push_back(distinct[k].leaf);
@@ -243,7 +244,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     // Without the robustness loop, or past it: the rest are checked in rank order.
     int kept = 0;
     for (Item& it : distinct) {
-      if (kept >= config.max_candidates) break;
+      if (kept >= ranked) break;
       kept += placeable(it) || config.keep_colliding;
     }
     sortItems(distinct, leaves);
@@ -263,12 +264,12 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
         it.stable = false;
         if (stats) ++stats->unseen_withheld;
       }
-  // Push resistance of the stable candidates to be returned (bounded: max_candidates of them),
+  // Push resistance of the best stable candidates (bounded: rankedCandidates() of them),
   // from the contacts in cells of a tenth of the object's radius; they are ranked again with it.
   const ForceModelParams forces{config.friction, 8, 3.0};
   std::vector<Item*> to_push;
   for (Item& it : distinct) {
-    if (static_cast<int>(to_push.size()) >= config.max_candidates) break;
+    if (static_cast<int>(to_push.size()) >= ranked) break;
     if (offered(it) && it.stable) to_push.push_back(&it);
   }
   // One small LP per direction and candidate, each candidate on its own: over the threads.

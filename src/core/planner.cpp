@@ -285,10 +285,12 @@ struct SearchMonitor {
     // Until a robust stable pose is found, the new stable leaves are checked at once, in chunks
     // that double while none holds (1, 2, 4, 8: many trials in flight where poses keep failing,
     // as on peg tops; one check where the first holds). Bounded work: after 2 x rankedCandidates()
-    // checks without one, the ranking checks the best of the rest (it would check them anyway).
+    // checks without one, or past max_tree_nodes (the trials' nodes count), the ranking checks
+    // the best of the rest (it would check them anyway).
     size_t j = 0;
     const size_t max_checks = 2 * static_cast<size_t>(config.rankedCandidates());
-    while (j < fresh.size() && st.first_stable_ms < 0 && config.robust_check && checked.size() < max_checks) {
+    while (j < fresh.size() && st.first_stable_ms < 0 && config.robust_check && checked.size() < max_checks &&
+           st.tree_nodes < config.max_tree_nodes) {
       const size_t n = std::min({fresh.size() - j, chunk, max_checks - checked.size()});
       const std::vector<size_t> batch(fresh.begin() + j, fresh.begin() + j + n);
       const std::vector<Robustness> rs = robustness(batch);

@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "place_planner/model/area_up.h"
+#include "place_planner/model/winding.h"
 
 namespace place_planner {
 
@@ -41,75 +42,15 @@ Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W) {
 }
 
 std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg, const StopSignal* stop) {
-  // Each undirected edge with the triangles on it, and whether the first traverses it a -> b:
-  // sorted (edge key, triangle) pairs grouped by key (a map is ten times slower on big scans).
-  struct EdgeUse {
-    int tris[2] = {-1, -1};
-    int count = 0;
-    int forward = 0;  // triangles traversing it from the lower index to the higher
-  };
-  auto edgeKey = [](int a, int b) { return (static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b); };
-  std::vector<std::pair<uint64_t, int>> sides;  // key, triangle * 2 + forward
-  sides.reserve(3 * mesh.triangles.size());
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    pollStop(stop, t, 1u << 14);
-    for (int k = 0; k < 3; ++k) {
-      int a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
-      const bool fwd = a < b;
-      if (a > b) std::swap(a, b);
-      sides.emplace_back(edgeKey(a, b), static_cast<int>(2 * t + fwd));
-    }
-  }
-  std::sort(sides.begin(), sides.end());
-  if (stop) stop->throwIfRequested();
-  std::vector<uint64_t> keys;
-  std::vector<EdgeUse> uses;
-  for (const auto& sd : sides) {
-    if (keys.empty() || keys.back() != sd.first) keys.push_back(sd.first), uses.emplace_back();
-    EdgeUse& u = uses.back();
-    if (u.count < 2) u.tris[u.count] = sd.second / 2;
-    ++u.count;
-    u.forward += sd.second % 2;
-  }
-  auto useOf = [&](int a, int b) -> const EdgeUse* {
-    const auto it = std::lower_bound(keys.begin(), keys.end(), edgeKey(a, b));
-    return it != keys.end() && *it == edgeKey(a, b) ? &uses[it - keys.begin()] : nullptr;
-  };
-  // Which side is solid, per connected piece (a scene may merge parts wound either way): on a
-  // consistently wound, (nearly) closed piece the winding's normals point out where its signed
-  // volume is positive and in where it is negative. Open sheets and scans (more than 2 % border
-  // edges) have no inside: every side may be touched (outward 0).
-  std::vector<int> piece(mesh.triangles.size());
-  for (size_t t = 0; t < piece.size(); ++t) piece[t] = static_cast<int>(t);
-  auto find = [&](int t) {
-    while (piece[t] != t) t = piece[t] = piece[piece[t]];
-    return t;
-  };
-  for (const EdgeUse& e : uses)
-    if (e.count == 2) piece[find(e.tris[0])] = find(e.tris[1]);
-  struct Piece {
-    int edges = 0, border = 0;
-    bool consistent = true;
-    double volume = 0;
-  };
-  std::vector<Piece> pieces(mesh.triangles.size());  // at each piece's root triangle
-  for (const EdgeUse& e : uses) {
-    Piece& p = pieces[find(e.tris[0])];
-    ++p.edges;
-    p.border += e.count == 1;
-    if (e.count == 2 && e.forward != 1) p.consistent = false;
-  }
-  const Eigen::Vector3d o = mesh.properties.center_of_mass;
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const auto& tri = mesh.triangles[t];
-    pieces[find(static_cast<int>(t))].volume +=
-        (mesh.vertices[tri[0]] - o).dot((mesh.vertices[tri[1]] - o).cross(mesh.vertices[tri[2]] - o));
-  }
-  auto outward = [&](int t) {
-    const Piece& p = pieces[find(t)];
-    if (!p.consistent || p.border > 0.02 * p.edges) return 0;
-    return (p.volume > 0) - (p.volume < 0);
-  };
+  // Each undirected edge with the triangles on it (winding.h), and which side is solid, per
+  // connected piece (a scene may merge parts wound either way): on a consistently wound,
+  // (nearly) closed piece the winding's normals point out where its signed volume is positive
+  // and in where it is negative. Open sheets and scans (more than 2 % border edges) have no
+  // inside: every side may be touched (solidSide 0).
+  const EdgeUses uses = edgeUses(mesh, stop);
+  const MeshPieces pieces = meshPieces(mesh, uses);
+  auto useOf = [&](int a, int b) { return uses.find(a, b); };
+  auto outward = [&](int t) { return pieces.solidSide(t); };
 
   const double cos_flat = std::cos(flat_deg * M_PI / 180.0);
   auto normal = [&](int t) {
@@ -122,7 +63,7 @@ std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg, 
   for (size_t ei = 0; ei < mesh.edges.size(); ++ei) {
     pollStop(stop, ei, 1u << 14);
     const auto& e = mesh.edges[ei];
-    const EdgeUse* use = useOf(e[0], e[1]);
+    const EdgeUses::Use* use = useOf(e[0], e[1]);
     if (use && use->count == 2) {
       const int t1 = use->tris[0], t2 = use->tris[1];
       const Eigen::Vector3d n1 = normal(t1);
@@ -243,9 +184,11 @@ void addProbes(ObjectModel& o, double spacing) {
   o.probe_bvh = buildBvh(boxes);
 }
 
-AreaModel buildAreaModel(const Mesh& area_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
+AreaModel buildAreaModel(const Mesh& area_in_W, const Eigen::Vector3d& gravity_W, double sphere_radius,
                          double collision_distance, double grid_cell, const StopSignal* stop) {
   AreaModel a;
+  // Wound outwards first (winding.h): the models read the area's solid side from its winding.
+  const Mesh area_W = woundOutwards(area_in_W, -gravity_W, &a.winding_reversed, 0.05, stop);
   a.R_GW = gravityFrame(gravity_W);
   // The area's spheres are reached through the height grid (V-B), not a BVH.
   HeightGrid grid;

@@ -20,6 +20,7 @@
 #include "place_planner/model/completion.h"
 #include "place_planner/model/despike.h"
 #include "place_planner/model/area_up.h"
+#include "place_planner/model/winding.h"
 #include "place_planner/infra/backend.h"
 #include "place_planner/infra/cuda_backend.h"
 #include "place_planner/search/floor_points.h"
@@ -845,8 +846,14 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   return again;
 }
 
-PlanResult Planner::planOnce(const Mesh& object, const Mesh& area, const PlannerConfig& config,
+PlanResult Planner::planOnce(const Mesh& object_in, const Mesh& area, const PlannerConfig& config,
                              const ProgressCallback& progress, bool* closed) const {
+  // A closed object wound inwards is wound outwards (model/winding.h: its sphere model's normals
+  // tell its outside; an open scan has no inside to judge it by and is kept as given). The area
+  // is wound outwards with its model (buildAreaModel), by gravity.
+  const bool inwards = woundInwards(object_in, Eigen::Vector3d::Zero());
+  const Mesh reversed = inwards ? reversedWinding(object_in) : Mesh();
+  const Mesh& object = inwards ? reversed : object_in;
   // Unseen is not empty: open regions of a scanned object capped (model/completion.h), after
   // its noise spikes are flattened (model/despike.h; an open mesh is a scan).
   int spikes = 0;

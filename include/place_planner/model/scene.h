@@ -71,8 +71,8 @@ struct AreaModel : MeshModel {  // frame G
   // Borders of what the area's scan saw (edges of one triangle, completion.h), frame G: beyond
   // them the area is unknown, so a pose leaning there needs surface that was not seen.
   std::vector<std::array<Eigen::Vector3d, 2>> open_edges;
-  // 1 where the mesh given was wound inwards and is modelled wound outwards (winding.h).
-  int winding_reversed = 0;
+  // The mesh given was wound inwards and is modelled wound outwards (winding.h).
+  bool winding_reversed = false;
 };
 
 // Edges for the edge/edge tests: all but those between two (nearly) coplanar triangles. A

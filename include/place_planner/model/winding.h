@@ -47,14 +47,17 @@ struct MeshPieces {
 };
 MeshPieces meshPieces(const Mesh& mesh, const EdgeUses& uses);
 
-// The mesh wound outwards: reversed as a whole where it is wound inwards. Where most of its
-// consistently wound surface lies on closed pieces (whose area-weighted normal is under a tenth
-// of their area: zero on a closed surface, about the area on a sheet), by their total
-// signed volume (negative: inwards; a cavity inside a solid keeps its inward winding); where
-// most lies on open pieces (a scan, a sheet), by their area-weighted normal, which points along
-// -up by more than min_share of their area (a scan seen from above faces up; one that faces
-// neither way, a wall, is left). `reversed` (may be null): 1 where it was reversed, else 0.
-Mesh woundOutwards(const Mesh& mesh, const Eigen::Vector3d& up, int* reversed = nullptr, double min_share = 0.05,
-                   const StopSignal* stop = nullptr);
+// Whether the mesh is wound inwards, as a whole. Where most of its consistently wound surface
+// lies on closed pieces (whose area-weighted normal is under a tenth of their area: zero on a
+// closed surface, about the area on a sheet), by their total signed volume (negative: inwards;
+// a cavity inside a solid keeps its inward winding); where most lies on open pieces (a scan, a
+// sheet), by their area-weighted normal, which points along -up by more than min_share of their
+// area (a scan seen from above faces up; one that faces neither way, a wall, is not judged).
+// `up` zero: open pieces are never judged inwards (an object's scan has no up).
+bool woundInwards(const Mesh& mesh, const Eigen::Vector3d& up, double min_share = 0.05,
+                  const StopSignal* stop = nullptr);
+
+// The same surface with every triangle and patch wound the other way (normals reversed).
+Mesh reversedWinding(const Mesh& mesh);
 
 }  // namespace place_planner

@@ -188,7 +188,9 @@ AreaModel buildAreaModel(const Mesh& area_in_W, const Eigen::Vector3d& gravity_W
                          double collision_distance, double grid_cell, const StopSignal* stop) {
   AreaModel a;
   // Wound outwards first (winding.h): the models read the area's solid side from its winding.
-  const Mesh area_W = woundOutwards(area_in_W, -gravity_W, &a.winding_reversed, 0.05, stop);
+  a.winding_reversed = woundInwards(area_in_W, -gravity_W, 0.05, stop);
+  const Mesh reversed = a.winding_reversed ? reversedWinding(area_in_W) : Mesh();
+  const Mesh& area_W = a.winding_reversed ? reversed : area_in_W;
   a.R_GW = gravityFrame(gravity_W);
   // The area's spheres are reached through the height grid (V-B), not a BVH.
   HeightGrid grid;

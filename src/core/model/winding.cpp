@@ -6,7 +6,7 @@
 namespace place_planner {
 namespace {
 
-// A piece whose area-weighted normal is under this share of its area is closed (woundOutwards).
+// A piece whose area-weighted normal is under this share of its area is closed (woundInwards).
 constexpr double kClosedNormalShare = 0.1;
 
 uint64_t edgeKey(int a, int b) {
@@ -81,10 +81,9 @@ int MeshPieces::solidSide(int triangle) const {
   return (p.volume > 0) - (p.volume < 0);
 }
 
-Mesh woundOutwards(const Mesh& mesh, const Eigen::Vector3d& up, int* reversed, double min_share,
-                   const StopSignal* stop) {
+bool woundInwards(const Mesh& mesh, const Eigen::Vector3d& up, double min_share, const StopSignal* stop) {
   const MeshPieces mp = meshPieces(mesh, edgeUses(mesh, stop));
-  const Eigen::Vector3d u = up.normalized();
+  const Eigen::Vector3d u = up.norm() > 0 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d::Zero();
   // One decision for the whole mesh, so that a cavity (a closed piece wound inwards inside a
   // solid, as a signed-distance reconstruction leaves them) stays one.
   double closed_area = 0, closed_volume = 0, open_area = 0, open_up = 0;
@@ -103,10 +102,11 @@ Mesh woundOutwards(const Mesh& mesh, const Eigen::Vector3d& up, int* reversed, d
       open_up += p.normal_area.dot(u);
     }
   }
-  const bool inwards = closed_area >= open_area && closed_area > 0 ? closed_volume < 0
-                                                                   : open_up < -min_share * open_area;
-  if (reversed) *reversed = inwards;
-  if (!inwards) return mesh;
+  if (closed_area >= open_area && closed_area > 0) return closed_volume < 0;
+  return open_up < -min_share * open_area;
+}
+
+Mesh reversedWinding(const Mesh& mesh) {
   Mesh out = mesh;
   for (auto& t : out.triangles) std::swap(t[1], t[2]);
   for (auto& p : out.patches) std::reverse(p.begin(), p.end());

@@ -11,6 +11,7 @@
 
 #include "place_planner/model/bvh.h"
 #include "place_planner/model/mesh.h"
+#include "place_planner/model/winding.h"
 #include "place_planner/infra/stop_signal.h"
 
 namespace place_planner {
@@ -81,15 +82,17 @@ struct AreaModel : MeshModel {  // frame G
 // borders can meet as edge against edge. flat_deg bounds the dihedral angle called flat.
 // On a closed, consistently wound mesh (a solid) valley edges are dropped too: a crossing
 // contact needs both edges to be ridges (see scene.cpp); open sheets keep both kinds.
+// `uses`: the mesh's edge uses (winding.h) when known already, else found here.
 std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg = 2.0,
-                                             const StopSignal* stop = nullptr);
+                                             const StopSignal* stop = nullptr, const EdgeUses* uses = nullptr);
 
 // `stop` (may be null) interrupts the builds below with Stopped (stop_signal.h).
 // index_spheres(spheres, bounds) builds the index of the sphere model (the object's BVH, the
 // area's height grid); it runs on the thread that samples the spheres, beside the BVH builds.
 using SphereIndexer = std::function<void(SphereModel&, const Aabb&)>;
 MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius,
-                         const SphereIndexer& index_spheres = {}, const StopSignal* stop = nullptr);
+                         const SphereIndexer& index_spheres = {}, const StopSignal* stop = nullptr,
+                         const EdgeUses* uses = nullptr);
 ObjectModel buildObjectModel(const Mesh& object_O, double sphere_radius, const StopSignal* stop = nullptr);
 // Fills o.probes and o.probe_bvh, at most `spacing` apart on each triangle (coarser past 20000
 // probes). The planner adds them where the area has pegs (a hanging pose's guard, penetration.h),

@@ -56,6 +56,8 @@ MeshPieces meshPieces(const Mesh& mesh, const EdgeUses& uses);
 // `up` zero: open pieces are never judged inwards (an object's scan has no up).
 bool woundInwards(const Mesh& mesh, const Eigen::Vector3d& up, double min_share = 0.05,
                   const StopSignal* stop = nullptr);
+// The same with the mesh's edge uses known already.
+bool woundInwards(const Mesh& mesh, const EdgeUses& uses, const Eigen::Vector3d& up, double min_share = 0.05);
 
 // The same surface with every triangle and patch wound the other way (normals reversed).
 Mesh reversedWinding(const Mesh& mesh);

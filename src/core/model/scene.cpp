@@ -41,13 +41,15 @@ Eigen::Matrix3d gravityFrame(const Eigen::Vector3d& gravity_W) {
   return Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
-std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg, const StopSignal* stop) {
+std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg, const StopSignal* stop,
+                                             const EdgeUses* known_uses) {
   // Each undirected edge with the triangles on it (winding.h), and which side is solid, per
   // connected piece (a scene may merge parts wound either way): on a consistently wound,
   // (nearly) closed piece the winding's normals point out where its signed volume is positive
   // and in where it is negative. Open sheets and scans (more than 2 % border edges) have no
   // inside: every side may be touched (solidSide 0).
-  const EdgeUses uses = edgeUses(mesh, stop);
+  const EdgeUses found = known_uses ? EdgeUses{} : edgeUses(mesh, stop);
+  const EdgeUses& uses = known_uses ? *known_uses : found;
   const MeshPieces pieces = meshPieces(mesh, uses);
   auto useOf = [&](int a, int b) { return uses.find(a, b); };
   auto outward = [&](int t) { return pieces.solidSide(t); };
@@ -84,7 +86,7 @@ std::vector<std::array<int, 2>> featureEdges(const Mesh& mesh, double flat_deg, 
 }
 
 MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphere_radius,
-                         const SphereIndexer& index_spheres, const StopSignal* stop) {
+                         const SphereIndexer& index_spheres, const StopSignal* stop, const EdgeUses* uses) {
   MeshModel m;
   m.vertices.reserve(mesh.vertices.size());
   m.bounds = aabbEmpty();
@@ -102,7 +104,7 @@ MeshModel buildMeshModel(const Mesh& mesh, const Eigen::Matrix3d& R, double sphe
     return sm;
   });
   // A Stopped thrown here waits for the sphere thread (std::async's future), which stops too.
-  m.edges = featureEdges(mesh, 2.0, stop);
+  m.edges = featureEdges(mesh, 2.0, stop, uses);
   std::vector<Aabb> tri_boxes, edge_boxes, vert_boxes;
   tri_boxes.reserve(m.triangles.size());
   for (const auto& t : m.triangles) {
@@ -188,9 +190,13 @@ AreaModel buildAreaModel(const Mesh& area_in_W, const Eigen::Vector3d& gravity_W
                          double collision_distance, double grid_cell, const StopSignal* stop) {
   AreaModel a;
   // Wound outwards first (winding.h): the models read the area's solid side from its winding.
-  a.winding_reversed = woundInwards(area_in_W, -gravity_W, 0.05, stop);
+  // Its edge uses serve the feature edges too (reversed, each edge is traversed the other way).
+  EdgeUses uses = edgeUses(area_in_W, stop);
+  a.winding_reversed = woundInwards(area_in_W, uses, -gravity_W);
   const Mesh reversed = a.winding_reversed ? reversedWinding(area_in_W) : Mesh();
   const Mesh& area_W = a.winding_reversed ? reversed : area_in_W;
+  if (a.winding_reversed)
+    for (EdgeUses::Use& u : uses.uses) u.forward = u.count - u.forward;
   a.R_GW = gravityFrame(gravity_W);
   // The area's spheres are reached through the height grid (V-B), not a BVH.
   HeightGrid grid;
@@ -198,7 +204,7 @@ AreaModel buildAreaModel(const Mesh& area_in_W, const Eigen::Vector3d& gravity_W
       area_W, a.R_GW, sphere_radius, [&](SphereModel& sm, const Aabb& bounds) {
         grid = buildHeightGrid(sm, bounds, collision_distance, grid_cell, stop);
       },
-      stop);
+      stop, &uses);
   a.grid = std::move(grid);
   a.source_triangles = area_W.triangles.size();
   static std::atomic<uint64_t> next_id{1};

@@ -82,7 +82,11 @@ int MeshPieces::solidSide(int triangle) const {
 }
 
 bool woundInwards(const Mesh& mesh, const Eigen::Vector3d& up, double min_share, const StopSignal* stop) {
-  const MeshPieces mp = meshPieces(mesh, edgeUses(mesh, stop));
+  return woundInwards(mesh, edgeUses(mesh, stop), up, min_share);
+}
+
+bool woundInwards(const Mesh& mesh, const EdgeUses& uses, const Eigen::Vector3d& up, double min_share) {
+  const MeshPieces mp = meshPieces(mesh, uses);
   const Eigen::Vector3d u = up.norm() > 0 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d::Zero();
   // One decision for the whole mesh, so that a cavity (a closed piece wound inwards inside a
   // solid, as a signed-distance reconstruction leaves them) stays one.

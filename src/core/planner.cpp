@@ -420,6 +420,9 @@ std::optional<Models> buildModels(PlanRun& run, AreaModelCache& cache, double r 
     run.result.warnings.push_back(
         decimationWarning("placement area mesh", am.source_triangles, am.triangles.size(), am.decimation_cell));
   warnAboutGravity(run.area, am, m.d_g_W, run.result);
+  if (am.winding_reversed)
+    run.result.warnings.push_back("placement area mesh: wound inwards (its normals point into the solid, or down on a "
+                                  "scan seen from above); planned wound outwards (model/winding.h)");
   m.d_vis = toV3(am.R_GW * m.d_vis_W);
   m.backend = chooseBackend(m.om, am, TiltParams{0.002, 1e-6 + 1e-4 * m.rad.r}, config, &run.st().backend_note);
   run.st().backend = m.backend->name();
@@ -866,6 +869,9 @@ PlanResult Planner::planOnce(const Mesh& object_in, const Mesh& area, const Plan
   }
   PlanRun run(completion, area, config, progress);
   run.result.stats.spikes_flattened = spikes;
+  if (inwards)
+    run.result.warnings.push_back("object mesh: wound inwards (its normals point into the solid); planned wound "
+                                  "outwards (model/winding.h)");
   // ---- models (III, V-B)
   const size_t warnings = run.result.warnings.size();
   std::optional<Models> models = buildModels(run, *cache_);

@@ -100,6 +100,13 @@ TEST(PlannerShared, AnAreaWoundInwardsPlansAsWoundOutwards) {
   const PlanResult out = Planner().plan(mug, rack, cfg);
   const PlanResult in = Planner().plan(mug, reversed(rack), cfg);
   ASSERT_GT(out.stableCount(), 0);
+  // Said in a warning, the answer's only change.
+  auto saysWound = [](const PlanResult& r) {
+    return std::any_of(r.warnings.begin(), r.warnings.end(),
+                       [](const std::string& w) { return w.find("wound inwards") != std::string::npos; });
+  };
+  EXPECT_TRUE(saysWound(in));
+  EXPECT_FALSE(saysWound(out));
   EXPECT_EQ(in.stableCount(), out.stableCount());
   for (const Candidate& c : in.candidates) {
     if (!c.stable) continue;
@@ -126,4 +133,6 @@ TEST(Winding, AnObjectWoundInwardsHangsAsWoundOutwards) {
   // the poses need not be the same ones.)
   ASSERT_GT(in.stableCount(), 0);
   EXPECT_TRUE(in.candidates.front().hanging);
+  EXPECT_TRUE(std::any_of(in.warnings.begin(), in.warnings.end(),
+                          [](const std::string& w) { return w.find("object mesh: wound inwards") == 0; }));
 }

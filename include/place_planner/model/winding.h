@@ -1,9 +1,10 @@
-// Which way a mesh is wound (beyond the paper). A reconstruction's winding is a
-// convention (marching cubes and mesh tools differ), but the models read the solid side of the
-// area from it: the sphere model's normals, the contact normals' sides (sphereContact), the
-// valley edges of a solid (featureEdges). An area wound inwards planned worse than the same area
-// wound outwards (the mug on `dish_rack` reversed: no stable pose against four), so the area is
-// wound outwards before its model is built. Frame: the mesh's own.
+// Which way a mesh is wound (beyond the paper). A reconstruction's winding is a convention
+// (marching cubes and mesh tools differ), but the models read the solid side from it: the
+// sphere model's normals, the contact normals' sides (sphereContact), the valley edges of a
+// solid (featureEdges). Wound inwards, the rack planned worse than wound outwards (the mug on
+// `dish_rack`: one stable pose against four) and a looped mug hung on no rack, so both meshes
+// are wound outwards before they are modelled: the area in buildAreaModel (by gravity), the
+// object in the planner (by its volume). Frame: the mesh's own.
 // The pieces (connected by shared edges) and their edge uses serve featureEdges too.
 #pragma once
 #include <Eigen/Core>

@@ -823,11 +823,23 @@ Planner::Planner() : cache_(std::make_shared<AreaModelCache>()) {}
 
 void Planner::clearAreaCache() const { cache_->clear(); }
 
-PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConfig& config,
+PlanResult Planner::plan(const Mesh& object_in, const Mesh& area, const PlannerConfig& config,
                          const ProgressCallback& progress) const {
   validate(config);
-  if (object.empty()) throw std::invalid_argument("object mesh is empty");
+  if (object_in.empty()) throw std::invalid_argument("object mesh is empty");
   if (area.empty()) throw std::invalid_argument("placement area mesh is empty");
+  // A closed object wound inwards is wound outwards (model/winding.h: its sphere model's normals
+  // tell its outside; an open scan has no inside to judge it by and is kept as given), once for
+  // both plans below. The area is wound outwards with its model (buildAreaModel), by gravity.
+  const bool inwards = woundInwards(object_in, Eigen::Vector3d::Zero());
+  const Mesh reversed = inwards ? reversedWinding(object_in) : Mesh();
+  const Mesh& object = inwards ? reversed : object_in;
+  auto said = [inwards](PlanResult res) {
+    if (inwards)
+      res.warnings.insert(res.warnings.begin(), "object mesh: wound inwards (its normals point into the solid); "
+                                                "planned wound outwards (model/winding.h)");
+    return res;
+  };
   bool closed = false;
   PlanResult r = planOnce(object, area, config, progress, &closed);
   // A closed mesh planned as a scan (closed_scan) with no pose that holds within its noise, where
@@ -835,7 +847,7 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   // trials of the centre of mass moved by the noise): planned again as exact, and said so. With
   // nothing held even by statics (a ramp steeper than the friction angle) it is not.
   const bool noise_turned_down = r.stats.roll_bottoms > 0 || r.stats.robustness_checked > 0;
-  if (!config.closed_scan || !closed || r.outcome() != PlanOutcome::kNoStable || !noise_turned_down) return r;
+  if (!config.closed_scan || !closed || r.outcome() != PlanOutcome::kNoStable || !noise_turned_down) return said(std::move(r));
   PlannerConfig exact = config;
   exact.closed_scan = false;
   if (exact.time_budget_ms > 0) exact.time_budget_ms = std::max(1.0, exact.time_budget_ms - r.stats.total_ms);
@@ -846,17 +858,11 @@ PlanResult Planner::plan(const Mesh& object, const Mesh& area, const PlannerConf
   std::snprintf(noise, sizeof noise, "%.1f mm", 1e3 * config.scan_noise);
   again.warnings.push_back(std::string("no pose of the closed object mesh holds within scan_noise (") + noise +
                            "): planned again as an exact mesh, so its poses trust the mesh's shape finer than a scan's noise (closed_scan)");
-  return again;
+  return said(std::move(again));
 }
 
-PlanResult Planner::planOnce(const Mesh& object_in, const Mesh& area, const PlannerConfig& config,
+PlanResult Planner::planOnce(const Mesh& object, const Mesh& area, const PlannerConfig& config,
                              const ProgressCallback& progress, bool* closed) const {
-  // A closed object wound inwards is wound outwards (model/winding.h: its sphere model's normals
-  // tell its outside; an open scan has no inside to judge it by and is kept as given). The area
-  // is wound outwards with its model (buildAreaModel), by gravity.
-  const bool inwards = woundInwards(object_in, Eigen::Vector3d::Zero());
-  const Mesh reversed = inwards ? reversedWinding(object_in) : Mesh();
-  const Mesh& object = inwards ? reversed : object_in;
   // Unseen is not empty: open regions of a scanned object capped (model/completion.h), after
   // its noise spikes are flattened (model/despike.h; an open mesh is a scan).
   int spikes = 0;
@@ -869,9 +875,6 @@ PlanResult Planner::planOnce(const Mesh& object_in, const Mesh& area, const Plan
   }
   PlanRun run(completion, area, config, progress);
   run.result.stats.spikes_flattened = spikes;
-  if (inwards)
-    run.result.warnings.push_back("object mesh: wound inwards (its normals point into the solid); planned wound "
-                                  "outwards (model/winding.h)");
   // ---- models (III, V-B)
   const size_t warnings = run.result.warnings.size();
   std::optional<Models> models = buildModels(run, *cache_);

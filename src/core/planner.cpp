@@ -31,6 +31,8 @@
 #include "place_planner/manipulation/placeability.h"
 #include "place_planner/judgement/ranking.h"
 #include "place_planner/judgement/robustness.h"
+#include "place_planner/judgement/drop_margin.h"
+#include "place_planner/search/opening_points.h"
 #include "place_planner/search/root_search.h"
 #include "place_planner/search/start_orientations.h"
 #include "place_planner/infra/work_limits.h"
@@ -98,8 +100,9 @@ void warnAboutGravity(const Mesh& area, const AreaModel& am, const Eigen::Vector
 }
 
 // Floor points (IV-B) in G, in the anytime order, restricted to the region when one is set.
-std::vector<V3> findFloorPoints(const AreaModel& am, const PlannerConfig& config, const V3& d_vis,
-                                const StopSignal* stop, std::vector<std::string>& warnings) {
+std::vector<V3> findFloorPoints(const AreaModel& am, const MeshProperties& object, const PlannerConfig& config,
+                                const V3& d_vis, const StopSignal* stop, std::vector<std::string>& warnings,
+                                int* openings) {
   FloorPointParams fpp;
   fpp.d_vis = d_vis;
   fpp.spacing = config.floor_point_spacing;
@@ -120,7 +123,27 @@ std::vector<V3> findFloorPoints(const AreaModel& am, const PlannerConfig& config
                                 (pw.array() <= config.region_max.array()).all()))
       kept.push_back(p);
   }
-  return orderFloorPoints(kept, fp.spacing);
+  std::vector<V3> ordered = orderFloorPoints(kept, fp.spacing);
+  // The middles of the openings the grid's rays fell into (opening_points.h), first: where a
+  // person puts an object into a cup or a compartment. Lowered along gravity only.
+  if (norm(d_vis - v3(0, 0, -1)) > 1e-6) return ordered;
+  Eigen::Vector3d ext = object.bounds_max - object.bounds_min;
+  std::sort(ext.data(), ext.data() + 3);
+  OpeningParams op;
+  op.reach = 1.25 * object.bounding_radius;  // walls the object would meet
+  op.wall_height = std::max(0.01, 0.25 * ext[1]);
+  op.min_clearance = 0.5 * ext[0];           // its narrowest side fits
+  op.merge = std::max(0.01, 0.25 * fp.spacing);
+  std::vector<V3> points;
+  for (const V3& c : openingCentres(am.grid, ordered, op)) {
+    const Eigen::Vector3d cw = am.R_GW.transpose() * toEigen(c);
+    if (!config.hasRegion() || ((cw.array() >= config.region_min.array()).all() &&
+                                (cw.array() <= config.region_max.array()).all()))
+      points.push_back(c);
+  }
+  *openings = static_cast<int>(points.size());
+  points.insert(points.end(), ordered.begin(), ordered.end());
+  return points;
 }
 
 // Sideways penetration allowed, in sphere radii: the contact distance of the object's spheres
@@ -485,9 +508,17 @@ double fineRadius(const PlanRun& run, const Models& m) {
 struct Roots {
   Eigen::Matrix3d R_held_G;
   std::vector<V3> floor_G;
+  int openings = 0;  // the first floor points: middles of openings (opening_points.h)
   std::vector<StartOrientation> orientations;
   std::vector<HangingStart> hanging;  // the object threaded by a loop on a peg (beyond the paper)
 };
+
+// The roots over the floor points and start orientations, those over openings turned to fit.
+RootSearch rootSearch(const Roots& r, const Models& m, const Mesh& object) {
+  RootSearch roots(r.floor_G, r.orientations, m.searched(object).properties, *m.am, m.d_vis, r.hanging);
+  roots.fitOpenings(r.openings, *m.am, m.om.spheres.centres);
+  return roots;
+}
 
 std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
   const AreaModel& am = *m.am;
@@ -501,7 +532,7 @@ std::optional<Roots> findRoots(PlanRun& run, const Models& m) {
   const PlacementKind kind = run.config.placement;
   const bool found = runStoppable(
                          [&] {
-                           r.floor_G = findFloorPoints(am, run.config, m.d_vis, &run.stop, floor_warnings);
+                           r.floor_G = findFloorPoints(am, m.searched(run.object).properties, run.config, m.d_vis, &run.stop, floor_warnings, &r.openings);
                            if (kind != PlacementKind::kHanging)
                              all = startOrientations(m.searched(run.object), r.R_held_G, toEigen(m.d_vis), am,
                                                      run.config, &run.stop);
@@ -545,7 +576,7 @@ class TreeSearch {
   TreeSearch(PlanRun& run, const Models& m, const Roots& r)
       : run_(run),
         m_(m),
-        roots_(r.floor_G, r.orientations, m.searched(run.object).properties, *m.am, m.d_vis, r.hanging),
+        roots_(rootSearch(r, m, run.object)),
         ctx_(treeContext(m.searched(run.object), m.om, *m.am, *m.backend, m.rad, run.config, run.st(),
                          run.scanned())),
         rp_(robustnessParams(run.config, run.scanned())),
@@ -610,6 +641,21 @@ class TreeSearch {
             return SupportKind::kAreaBorder;
         }
         return SupportKind::kSeen;
+      };
+    }
+    {
+      // Drop-offs within the object's size from its centre of mass (drop_margin.h).
+      Eigen::Vector3d ext = props.bounds_max - props.bounds_min;
+      std::sort(ext.data(), ext.data() + 3);
+      DropMarginParams dp;
+      dp.reach = props.bounding_radius;
+      dp.drop = dp.wall = std::max(0.01, 0.25 * ext[1]);
+      in.drop_margin = [this, dp](size_t i) {
+        const TreeLeaf& l = leaves_[i];
+        double low = kInf;
+        for (const ContactPoint& c : l.contacts) low = std::min(low, c.p_W.z());
+        if (!std::isfinite(low)) return 1.0;
+        return dropMargin(m_.am->grid, toEigen(apply(l.X_GO, ctx_.om.com)), low, dp);
       };
     }
     const PlaceabilityContext pc{m_.om, *m_.am, *m_.backend, m_.d_vis, config};

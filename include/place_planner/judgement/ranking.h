@@ -26,6 +26,9 @@ struct RankingInput {
   // True when a stable leaf rests on completed surface (model/completion.h): such poses rank
   // after every stable pose on seen surface. Empty: the object was closed.
   std::function<SupportKind(size_t)> completed_support = {};
+  // A stable standing leaf's distance to a drop-off of the area, 0 to 1 (drop_margin.h). Empty:
+  // not counted.
+  std::function<double(size_t)> drop_margin = {};
 };
 
 // Robustness of the leaves given by index (robustness.h); called on the best stable leaves
@@ -38,6 +41,7 @@ using PlacementCheck = std::function<Placement(size_t)>;
 // 5 mm steps; kNearest: distance to prefer_near in 5 mm steps), then by the score
 //   Q - 0.05 * reorientation / pi - w * (1 - robust share) + 0.25 * mean push resistance
 //     + 0.05 * clamp(smallest tipping margin of the held releases / 5 deg, 0, 1)
+//     + 0.1 * (drop margin - 1)
 // (re-orientation: the angle from the held orientation, a secondary key: a half turn costs as
 // much as 0.05 of Q; w = 1 for a stable pose, where a failed release of 12 costs 0.083, and
 // 0.05 for one that is not, ranking.cpp). It merges poses within merge_distance and

@@ -24,6 +24,9 @@ class RootSearch {
   RootSearch(const std::vector<V3>& floor_points_G, const std::vector<StartOrientation>& orientations,
              const MeshProperties& object, const AreaModel& area, const V3& d_vis_G,
              std::vector<HangingStart> hanging = {});
+  // The first floor points are the middles of openings (opening_points.h): their roots' start
+  // orientations are turned about the vertical to fit the opening (fittingYaw).
+  void fitOpenings(int opening_points, const AreaModel& area, const std::vector<V3>& surface_O);
   int size() const { return hangingCount() + static_cast<int>(floor_points_.size() * orientations_.size()); }
   int hangingCount() const { return static_cast<int>(hanging_.size()); }
   // The root's hanging start, null for a root over a floor point.
@@ -49,6 +52,7 @@ class RootSearch {
   double radius_;
   V3 d_vis_;
   double hmax_ = 0, hmin_ = 0;  // the area's extent along -d_vis
+  std::vector<double> yaw_;      // fitOpenings: per opening floor point and orientation (rad)
 };
 
 }  // namespace place_planner

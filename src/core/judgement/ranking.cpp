@@ -37,6 +37,10 @@ constexpr double kUnstableShareWeight = 0.05;
 // peg in Bullet (hanging suite, best 36/40 -> 37/40, top-3 105 -> 106/111); a 10 degree cap
 // also reorders lying bottles whose margins differ at 3-10 degrees (scan suite top-3 145 -> 144).
 constexpr double kTipWeight = 0.05, kTipFull = 5.0 * M_PI / 180.0;
+// A stable pose's distance to a drop-off of the area (RankingInput::drop_margin, 0 to 1) adds
+// to the score with this weight: a mug on a tray divider's 6 mm top (margin about 0.5) ranks
+// behind the same mug on the compartment's floor (1), whose Q is the same to 0.01.
+constexpr double kDropWeight = 0.1;
 // Leaves whose down directions (in O) lie within this rest on the same face (ranking's
 // robustness order).
 constexpr double kSameFaceDeg = 15.0;
@@ -54,11 +58,13 @@ struct Item {
   SupportKind support = SupportKind::kSeen;  // on unseen surface: after the seen ones
   PushResistance push;
   bool pushed = false;  // push computed
+  double drop_margin = 1.0;
   double score() const {
     const double share = checked ? robustness.share() : 1.0;
     const double w = stable ? kShareWeight : kUnstableShareWeight;
     const double tip = checked ? std::clamp(robustness.min_tipping_angle / kTipFull, 0.0, 1.0) : 1.0;
-    return quality - 0.05 * reorientation / M_PI - w * (1.0 - share) + kPushWeight * push.mean + kTipWeight * tip;
+    return quality - 0.05 * reorientation / M_PI - w * (1.0 - share) + kPushWeight * push.mean + kTipWeight * tip -
+           kDropWeight * (1.0 - drop_margin);
   }
 };
 
@@ -110,6 +116,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     }
     Item it{i, l.stable, l.quality, rotationAngle(in.R_held_G, X.linear()), {}, false, 0, {}, SupportKind::kSeen, {}, false};
     if (l.stable && in.completed_support) it.support = in.completed_support(i);
+    if (l.stable && !l.hanging && in.drop_margin) it.drop_margin = in.drop_margin(i);
     if (config.rank_order == RankOrder::kLowest) it.preference = quantised((X * in.com_O).z(), 0.005);
     if (config.rank_order == RankOrder::kNearest) it.preference = quantised((X * in.com_O - near_G).norm(), 0.005);
     items.push_back(it);

@@ -62,14 +62,31 @@ TEST(Openings, ALongObjectIsTurnedAlongItsCompartment) {
   const Mesh stick = scenes::box(0.2, 0.03, 0.03, {0, 0, 0.015});
   const Eigen::Matrix3d along_y = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const std::vector<V3> v = buildObjectModel(stick, 0.002).spheres.centres;  // its surface
-  const double yaw = fittingYaw(am.grid, v3(-0.06, 0.075, 0.01), along_y, v, toV3(stick.properties.center_of_mass));
+  const OpeningFit fit = fitIntoOpening(am.grid, v3(-0.06, 0.075, 0.01), along_y, v, toV3(stick.properties.center_of_mass));
   // Turned (the smallest turn that fits) until its extent across the compartment fits its 14.1 cm.
-  EXPECT_LT(0.2 * std::abs(std::cos(yaw)) + 0.03 * std::abs(std::sin(yaw)), 0.141) << yaw;
-  EXPECT_LE(std::abs(yaw), M_PI / 2 + 1e-9);
+  EXPECT_LT(0.2 * std::abs(std::cos(fit.yaw)) + 0.03 * std::abs(std::sin(fit.yaw)), 0.141) << fit.yaw;
+  EXPECT_LE(std::abs(fit.yaw), M_PI / 2 + 1e-9);
+  EXPECT_LT(fit.shift.norm(), 0.003);  // its footprint's middle is its centre of mass
   // Already along x: not turned.
-  EXPECT_EQ(fittingYaw(am.grid, v3(-0.06, 0.075, 0.01), Eigen::Matrix3d::Identity(), v,
-                       toV3(stick.properties.center_of_mass)),
+  EXPECT_EQ(fitIntoOpening(am.grid, v3(-0.06, 0.075, 0.01), Eigen::Matrix3d::Identity(), v,
+                           toV3(stick.properties.center_of_mass)).yaw,
             0.0);
+}
+
+// An object whose centre of mass is off its footprint's middle (a mug's handle) goes in with its
+// footprint's middle over the opening's.
+TEST(Openings, AnObjectsFootprintIsCentredInTheOpening) {
+  const AreaModel am = model(cup());
+  // A block 6 x 4 cm with a 3 cm tab on one side: its centre of mass off its footprint's middle.
+  const Mesh block = scenes::merge({scenes::box(0.06, 0.04, 0.04, {0, 0, 0.02}), scenes::box(0.03, 0.01, 0.02, {0.045, 0, 0.02})});
+  const std::vector<V3> v = buildObjectModel(block, 0.002).spheres.centres;
+  const OpeningFit fit = fitIntoOpening(am.grid, v3(0, 0, 0.01), Eigen::Matrix3d::Identity(), v,
+                                        toV3(block.properties.center_of_mass));
+  // Footprint x from -0.03 to 0.06: its middle 1.5 cm from x = 0, the centre of mass nearer.
+  const Eigen::Rotation2Dd R(fit.yaw);
+  const Eigen::Vector2d mid = R * Eigen::Vector2d(0.015 - block.properties.center_of_mass.x(), 0);
+  EXPECT_GT(mid.norm(), 0.007);  // the test would pass on no shift otherwise
+  EXPECT_LT((fit.shift + mid).norm(), 0.006) << fit.shift.transpose() << " / " << mid.transpose();
 }
 
 TEST(DropMargin, ADividersTopIsNearADropAndItsCompartmentIsNot) {

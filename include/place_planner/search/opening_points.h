@@ -34,12 +34,17 @@ double gridHeightAt(const HeightGrid& grid, double x, double y);
 // within `merge` of a floor point or of each other, in the order of the floor points they came from.
 std::vector<V3> openingCentres(const HeightGrid& grid, const std::vector<V3>& floor_points, const OpeningParams& p);
 
-// The turn about the vertical (rad) that fits the object, its centre of mass over `centre` and
-// turned by R_GO, into the opening there: the fewest of its surface points (frame O: the sphere
-// model's centres) over area higher than the point stands above the object's lowest, when the
-// object rests on the opening's floor
-// (a mug's handle along a compartment's longer side). Of equal fits the smallest turn; 24 turns.
-double fittingYaw(const HeightGrid& grid, const V3& centre, const Eigen::Matrix3d& R_GO,
-                  const std::vector<V3>& surface_O, const V3& com_O);
+// How the object goes into the opening at `centre`, turned by R_GO: turned about the vertical by
+// `yaw` (rad), its centre of mass `shift` from the centre (G), so that its footprint's middle is
+// over the opening's. The turn fits the fewest of its surface points (frame O: the sphere model's
+// centres) over area higher than the point stands above the object's lowest, when the object
+// rests on the opening's floor (a mug's handle along a compartment's longer side), then the
+// fewest with the footprint grown by `margin`; of equal fits the smallest turn. 24 turns.
+struct OpeningFit {
+  double yaw = 0;
+  Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+};
+OpeningFit fitIntoOpening(const HeightGrid& grid, const V3& centre, const Eigen::Matrix3d& R_GO,
+                          const std::vector<V3>& surface_O, const V3& com_O, double margin = 0.01);
 
 }  // namespace place_planner

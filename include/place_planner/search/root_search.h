@@ -7,6 +7,7 @@
 #include "place_planner/model/mesh.h"
 #include "place_planner/model/scene.h"
 #include "place_planner/search/hanging_starts.h"
+#include "place_planner/search/opening_points.h"
 #include "place_planner/search/start_orientations.h"
 
 namespace place_planner {
@@ -25,7 +26,8 @@ class RootSearch {
              const MeshProperties& object, const AreaModel& area, const V3& d_vis_G,
              std::vector<HangingStart> hanging = {});
   // The first floor points are the middles of openings (opening_points.h): their roots' start
-  // orientations are turned about the vertical to fit the opening (fittingYaw).
+  // orientations are turned about the vertical to fit the opening, their footprints' middles over
+  // its middle (fitIntoOpening).
   void fitOpenings(int opening_points, const AreaModel& area, const std::vector<V3>& surface_O);
   int size() const { return hangingCount() + static_cast<int>(floor_points_.size() * orientations_.size()); }
   int hangingCount() const { return static_cast<int>(hanging_.size()); }
@@ -52,7 +54,7 @@ class RootSearch {
   double radius_;
   V3 d_vis_;
   double hmax_ = 0, hmin_ = 0;  // the area's extent along -d_vis
-  std::vector<double> yaw_;      // fitOpenings: per opening floor point and orientation (rad)
+  std::vector<OpeningFit> fit_;  // fitOpenings: per opening floor point and orientation
 };
 
 }  // namespace place_planner

@@ -80,33 +80,49 @@ std::vector<V3> openingCentres(const HeightGrid& grid, const std::vector<V3>& fl
   return out;
 }
 
-double fittingYaw(const HeightGrid& grid, const V3& centre, const Eigen::Matrix3d& R_GO,
-                  const std::vector<V3>& surface_O, const V3& com_O) {
+OpeningFit fitIntoOpening(const HeightGrid& grid, const V3& centre, const Eigen::Matrix3d& R_GO,
+                          const std::vector<V3>& surface_O, const V3& com_O, double margin) {
   constexpr int kTurns = 24;
+  OpeningFit best;
   const double floor = gridHeightAt(grid, centre.x, centre.y);
-  if (!std::isfinite(floor) || surface_O.empty()) return 0.0;
-  // At most 256 points, spread over the surface.
+  if (!std::isfinite(floor) || surface_O.empty()) return best;
+  // At most 256 points, spread over the surface; about the centre of mass, turned by R_GO.
   const size_t stride = std::max<size_t>(1, surface_O.size() / 256);
   const Eigen::Vector3d c = R_GO * toEigen(com_O);
+  std::vector<Eigen::Vector3d> pts;
   double low = kInf;
-  for (size_t i = 0; i < surface_O.size(); i += stride) low = std::min(low, (R_GO * toEigen(surface_O[i])).z());
-  int best_hits = -1;
-  double best = 0;
+  for (size_t i = 0; i < surface_O.size(); i += stride) {
+    pts.push_back(R_GO * toEigen(surface_O[i]) - c);
+    low = std::min(low, pts.back().z());
+  }
+  int best_hits[2] = {-1, -1};
+  std::vector<Eigen::Vector2d> turned(pts.size());
   for (int k = 0; k < kTurns; ++k) {
     // 0, +15, -15, +30, ... degrees: the smallest turn first among equal fits.
     const double yaw = (k % 2 ? 1 : -1) * ((k + 1) / 2) * 2 * M_PI / kTurns;
-    const double cy = std::cos(yaw), sy = std::sin(yaw);
-    int hits = 0;
-    for (size_t i = 0; i < surface_O.size(); i += stride) {
-      const Eigen::Vector3d v = R_GO * toEigen(surface_O[i]) - c;
-      const double x = centre.x + cy * v.x() - sy * v.y(), y = centre.y + sy * v.x() + cy * v.y();
-      hits += gridHeightAt(grid, x, y) > floor + (v.z() + c.z() - low);
+    const Eigen::Rotation2Dd R(yaw);
+    Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
+    for (size_t i = 0; i < pts.size(); ++i) {
+      turned[i] = R * pts[i].head<2>();
+      lo = lo.cwiseMin(turned[i]);
+      hi = hi.cwiseMax(turned[i]);
     }
-    if (best_hits < 0 || hits < best_hits) {
-      best_hits = hits;
-      best = yaw;
+    const Eigen::Vector2d mid = 0.5 * (lo + hi);
+    int hits[2] = {0, 0};  // as it is, and grown by margin
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const Eigen::Vector2d q = Eigen::Vector2d(centre.x, centre.y) + turned[i] - mid;
+      const double top = floor + (pts[i].z() - low);  // the point's height, the object on the floor
+      const Eigen::Vector2d out = (turned[i] - mid).norm() > 1e-9 ? Eigen::Vector2d((turned[i] - mid).normalized()) : Eigen::Vector2d::Zero();
+      hits[0] += gridHeightAt(grid, q.x(), q.y()) > top;
+      hits[1] += gridHeightAt(grid, q.x() + margin * out.x(), q.y() + margin * out.y()) > top;
     }
-    if (hits == 0) break;
+    if (best_hits[0] < 0 || hits[0] < best_hits[0] || (hits[0] == best_hits[0] && hits[1] < best_hits[1])) {
+      best_hits[0] = hits[0];
+      best_hits[1] = hits[1];
+      best.yaw = yaw;
+      best.shift = -mid;
+    }
+    if (hits[0] == 0 && hits[1] == 0) break;
   }
   return best;
 }

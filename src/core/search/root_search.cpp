@@ -1,8 +1,6 @@
 // The search over roots (root_search.h).
 #include "place_planner/search/root_search.h"
 
-#include "place_planner/search/opening_points.h"
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -61,21 +59,21 @@ StartKind RootSearch::kind(int root) const {
 
 void RootSearch::fitOpenings(int opening_points, const AreaModel& area, const std::vector<V3>& surface_O) {
   const int n = std::min(opening_points, static_cast<int>(floor_points_.size()));
-  yaw_.assign(static_cast<size_t>(n) * orientations_.size(), 0.0);
+  fit_.assign(static_cast<size_t>(n) * orientations_.size(), OpeningFit{});
   for (int f = 0; f < n; ++f)
     for (size_t o = 0; o < orientations_.size(); ++o)
-      yaw_[f * orientations_.size() + o] =
-          fittingYaw(area.grid, floor_points_[f], orientations_[o].R_GO, surface_O, toV3(com_O_));
+      fit_[f * orientations_.size() + o] =
+          fitIntoOpening(area.grid, floor_points_[f], orientations_[o].R_GO, surface_O, toV3(com_O_));
 }
 
 Rigid RootSearch::pose(int root) const {
   if (const HangingStart* h = hanging(root)) return h->X_GO;
   const size_t o = (root - hangingCount()) % orientations_.size();
-  const size_t turned = static_cast<size_t>(floorPoint(root)) * orientations_.size() + o;
-  const Eigen::Matrix3d R = turned < yaw_.size()
-                                ? Eigen::Matrix3d(Eigen::AngleAxisd(yaw_[turned], Eigen::Vector3d::UnitZ()) * orientations_[o].R_GO)
-                                : orientations_[o].R_GO;
-  const Eigen::Vector3d com_G = toEigen(floor_points_[floorPoint(root)]) - clearance(root) * toEigen(d_vis_);
+  const size_t i = static_cast<size_t>(floorPoint(root)) * orientations_.size() + o;
+  const OpeningFit fit = i < fit_.size() ? fit_[i] : OpeningFit{};
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(fit.yaw, Eigen::Vector3d::UnitZ()) * orientations_[o].R_GO;
+  const Eigen::Vector3d com_G = toEigen(floor_points_[floorPoint(root)]) - clearance(root) * toEigen(d_vis_) +
+                                Eigen::Vector3d(fit.shift.x(), fit.shift.y(), 0);
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = R;
   X.translation() = com_G - R * com_O_;

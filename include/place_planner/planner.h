@@ -108,6 +108,10 @@ struct Candidate {
   double push_resistance = 0.0;
   double push_resistance_mean = 0.0;
   Eigen::Vector3d push_weakest_W = Eigen::Vector3d::UnitX();
+  // How far a standing pose is from a drop-off of the area, 0 to 1 (judgement/drop_margin.h):
+  // 1 in the middle of a table, in a cup or a compartment, about 0.5 on a narrow wall top. 1
+  // for a hanging pose or one not stable.
+  double drop_margin = 1.0;
   std::vector<ContactPoint> contacts;                       // at the goal pose
   Eigen::Vector3d floor_point_W = Eigen::Vector3d::Zero();
   // Ordered: pre-placement pose above the floor point first, one per translation or rotation,

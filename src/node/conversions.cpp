@@ -211,6 +211,7 @@ void toMsg(const Candidate& c, const std::string& frame_id, const std::string& g
   msg->curved_support = c.curved_support;
   msg->push_resistance = c.push_resistance;
   msg->push_resistance_mean = c.push_resistance_mean;
+  msg->drop_margin = c.drop_margin;
   msg->push_weakest_direction.header = msg->pose.header;
   toMsg(c.push_weakest_W, &msg->push_weakest_direction.vector);
   msg->robust_share = c.robustness.share();

@@ -273,6 +273,7 @@ Json resultJson(const std::string& object, const std::string& area, const Planne
         {"curved_support", k.curved_support},
         {"push_resistance",
          {{"min", k.push_resistance}, {"mean", k.push_resistance_mean}, {"weakest_direction", vecJson(k.push_weakest_W)}}},
+        {"drop_margin", k.drop_margin},
         {"start", toString(k.start)},
         {"kind", k.hanging ? "hanging" : "standing"},
         {"robustness",

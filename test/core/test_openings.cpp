@@ -117,4 +117,8 @@ TEST(PlannerOpenings, MugGoesIntoATraysCompartment) {
   double low = 1e9;
   for (const auto& v : mug.vertices) low = std::min(low, (best.X_WO * v).z());
   EXPECT_LT(low, 0.015) << "on the compartment's floor (1 cm), not on the walls (6 cm)";
+  EXPECT_GT(best.drop_margin, 0.95);  // walls round it, no drop-off
+  // A stable pose on the walls' tops, if any, is near a drop-off and ranks after it.
+  for (const auto& c : r.candidates)
+    if (c.stable && (c.X_WO * mug.properties.center_of_mass).z() > 0.08) EXPECT_LT(c.drop_margin, 0.9);
 }

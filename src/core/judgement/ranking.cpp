@@ -303,6 +303,7 @@ std::vector<Candidate> rankCandidates(const RankingInput& in, const PlannerConfi
     c.start = in.root_kind[l.root];
     c.hanging = l.hanging;
     c.reorientation = it.reorientation;
+    c.drop_margin = it.drop_margin;
     if (it.pushed) {
       c.push_resistance = it.push.min;
       c.push_resistance_mean = it.push.mean;

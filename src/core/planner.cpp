@@ -99,6 +99,21 @@ void warnAboutGravity(const Mesh& area, const AreaModel& am, const Eigen::Vector
   r.warnings.push_back(msg);
 }
 
+// A step of the area the object notices (m): a quarter of its middle extent, at least 1 cm; an
+// opening's wall (opening_points.h), a drop-off (drop_margin.h).
+double noticeableStep(const MeshProperties& object) {
+  Eigen::Vector3d ext = object.bounds_max - object.bounds_min;
+  std::sort(ext.data(), ext.data() + 3);
+  return std::max(0.01, 0.25 * ext[1]);
+}
+
+// Whether the point p (G) lies in the config's region (W), or no region is set.
+bool inRegion(const PlannerConfig& config, const AreaModel& am, const V3& p) {
+  const Eigen::Vector3d pw = am.R_GW.transpose() * toEigen(p);
+  return !config.hasRegion() ||
+         ((pw.array() >= config.region_min.array()).all() && (pw.array() <= config.region_max.array()).all());
+}
+
 // Floor points (IV-B) in G, in the anytime order, restricted to the region when one is set.
 std::vector<V3> findFloorPoints(const AreaModel& am, const MeshProperties& object, const PlannerConfig& config,
                                 const V3& d_vis, const StopSignal* stop, std::vector<std::string>& warnings,
@@ -117,12 +132,8 @@ std::vector<V3> findFloorPoints(const AreaModel& am, const MeshProperties& objec
     warnings.push_back(msg);
   }
   std::vector<V3> kept;
-  for (const V3& p : fp.points) {
-    const Eigen::Vector3d pw = am.R_GW.transpose() * toEigen(p);
-    if (!config.hasRegion() || ((pw.array() >= config.region_min.array()).all() &&
-                                (pw.array() <= config.region_max.array()).all()))
-      kept.push_back(p);
-  }
+  for (const V3& p : fp.points)
+    if (inRegion(config, am, p)) kept.push_back(p);
   std::vector<V3> ordered = orderFloorPoints(kept, fp.spacing);
   // The middles of the openings the grid's rays fell into (opening_points.h), first: where a
   // person puts an object into a cup or a compartment. Lowered along gravity only.
@@ -131,16 +142,12 @@ std::vector<V3> findFloorPoints(const AreaModel& am, const MeshProperties& objec
   std::sort(ext.data(), ext.data() + 3);
   OpeningParams op;
   op.reach = 1.25 * object.bounding_radius;  // walls the object would meet
-  op.wall_height = std::max(0.01, 0.25 * ext[1]);
+  op.wall_height = noticeableStep(object);
   op.min_clearance = 0.5 * ext[0];           // its narrowest side fits
   op.merge = std::max(0.01, 0.25 * fp.spacing);
   std::vector<V3> points;
-  for (const V3& c : openingCentres(am.grid, ordered, op)) {
-    const Eigen::Vector3d cw = am.R_GW.transpose() * toEigen(c);
-    if (!config.hasRegion() || ((cw.array() >= config.region_min.array()).all() &&
-                                (cw.array() <= config.region_max.array()).all()))
-      points.push_back(c);
-  }
+  for (const V3& c : openingCentres(am.grid, ordered, op))
+    if (inRegion(config, am, c)) points.push_back(c);
   *openings = static_cast<int>(points.size());
   points.insert(points.end(), ordered.begin(), ordered.end());
   return points;
@@ -645,11 +652,9 @@ class TreeSearch {
     }
     {
       // Drop-offs within the object's size from its centre of mass (drop_margin.h).
-      Eigen::Vector3d ext = props.bounds_max - props.bounds_min;
-      std::sort(ext.data(), ext.data() + 3);
       DropMarginParams dp;
       dp.reach = props.bounding_radius;
-      dp.drop = dp.wall = std::max(0.01, 0.25 * ext[1]);
+      dp.drop = dp.wall = noticeableStep(props);
       in.drop_margin = [this, dp](size_t i) {
         const TreeLeaf& l = leaves_[i];
         double low = kInf;

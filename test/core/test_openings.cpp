@@ -97,9 +97,13 @@ TEST(DropMargin, ADividersTopIsNearADropAndItsCompartmentIsNot) {
   const double floor = dropMargin(am.grid, Eigen::Vector3d(-0.06, 0.075, 0.05), 0.01, p);  // in a compartment
   EXPECT_LT(top, 0.7);
   EXPECT_GT(floor, 0.99);
-  const AreaModel table = model(scenes::table());  // 1.0 x 0.8 m
-  EXPECT_GT(dropMargin(table.grid, Eigen::Vector3d(0, 0, 0.05), 0.0, p), 0.99);
-  EXPECT_LT(dropMargin(table.grid, Eigen::Vector3d(0.48, 0, 0.05), 0.0, p), 0.9);  // 2 cm from its edge
+  // A table top 1.0 x 0.8 m, 75 cm over a floor: 2 cm from its edge the floor far below is a
+  // drop-off. A scan of the top alone (a sheet) says nothing of what lies beyond its edge.
+  const Mesh table = scenes::box(1.0, 0.8, 0.03, {0, 0, 0.735});
+  const AreaModel room = model(scenes::merge({table, scenes::box(2.0, 2.0, 0.01, {0, 0, -0.005})}));
+  EXPECT_GT(dropMargin(room.grid, Eigen::Vector3d(0, 0, 0.8), 0.75, p), 0.99);
+  EXPECT_LT(dropMargin(room.grid, Eigen::Vector3d(0.48, 0, 0.8), 0.75, p), 0.9);
+  EXPECT_GT(dropMargin(model(scenes::plane(1.0, 0.8)).grid, Eigen::Vector3d(0.48, 0, 0.05), 0.0, p), 0.99);
 }
 
 // A person puts the mug into one of the tray's compartments, not on a divider's 6 mm top. The

@@ -27,7 +27,8 @@ struct OpeningParams {
   double min_enclosed = 0.75; // share of the directions that must meet a wall
 };
 
-// The height grid's top at (x, y) (G): -inf off the grid or over an empty cell.
+// The height grid's top at (x, y) (G): its highest sphere centre plus the collision distance;
+// -infinity (not finite) off the grid or over an empty cell.
 double gridHeightAt(const HeightGrid& grid, double x, double y);
 
 // The middles of the openings around `floor_points` (G), each at its floor's height, not

@@ -19,8 +19,9 @@ double dropMargin(const HeightGrid& grid, const Eigen::Vector3d& com_G, double s
     for (int s = 1; s <= steps; ++s) {
       const double t = s * grid.cell;
       const double h = gridHeightAt(grid, com_G.x() + t * cx, com_G.y() + t * cy);
-      if (h > support_z + p.wall) break;  // caught by a wall
-      if (h < support_z - p.drop) {       // off the area or over a drop-off
+      // Where the area ends (off its mesh: a scan's border, a sheet's edge) nothing is known.
+      if (!std::isfinite(h) || h > support_z + p.wall) break;  // unknown, or caught by a wall
+      if (h < support_z - p.drop) {                             // over a drop-off
         d = t;
         break;
       }

@@ -146,7 +146,7 @@ std::vector<V3> findFloorPoints(const AreaModel& am, const MeshProperties& objec
   op.min_clearance = 0.5 * ext[0];           // its narrowest side fits
   op.merge = std::max(0.01, 0.25 * fp.spacing);
   std::vector<V3> points;
-  for (const V3& c : openingCentres(am.grid, ordered, op))
+  for (const V3& c : openingCentres(am.grid, ordered, op, stop))
     if (inRegion(config, am, c)) points.push_back(c);
   *openings = static_cast<int>(points.size());
   points.insert(points.end(), ordered.begin(), ordered.end());

@@ -25,6 +25,7 @@ struct OpeningParams {
   double min_clearance = 0;   // m: the opening's narrowest half-width must reach this
   double merge = 0.01;        // m: a centre this close to a floor point or another centre is not added
   double min_enclosed = 0.75; // share of the directions that must meet a wall
+  int max_openings = 64;      // bounded work: at most this many middles (each root there is fitted)
 };
 
 // The height grid's top at (x, y) (G): its highest sphere centre plus the collision distance;
@@ -32,8 +33,10 @@ struct OpeningParams {
 double gridHeightAt(const HeightGrid& grid, double x, double y);
 
 // The middles of the openings around `floor_points` (G), each at its floor's height, not
-// within `merge` of a floor point or of each other, in the order of the floor points they came from.
-std::vector<V3> openingCentres(const HeightGrid& grid, const std::vector<V3>& floor_points, const OpeningParams& p);
+// within `merge` of a floor point or of each other, in the order of the floor points they came from,
+// at most max_openings. `stop` (may be null) interrupts it with Stopped.
+std::vector<V3> openingCentres(const HeightGrid& grid, const std::vector<V3>& floor_points, const OpeningParams& p,
+                               const StopSignal* stop = nullptr);
 
 // How the object goes into the opening at `centre`, turned by R_GO: turned about the vertical by
 // `yaw` (rad), its centre of mass `shift` from the centre (G), so that its footprint's middle is

@@ -48,7 +48,8 @@ double gridHeightAt(const HeightGrid& g, double x, double y) {
   return g.max_z[static_cast<size_t>(iy) * g.nx + ix];
 }
 
-std::vector<V3> openingCentres(const HeightGrid& grid, const std::vector<V3>& floor_points, const OpeningParams& p) {
+std::vector<V3> openingCentres(const HeightGrid& grid, const std::vector<V3>& floor_points, const OpeningParams& p,
+                               const StopSignal* stop) {
   std::vector<V3> out;
   if (grid.nx == 0 || grid.ny == 0 || p.reach <= 0) return out;
   const int min_hits = static_cast<int>(std::ceil(p.min_enclosed * kDirections));
@@ -58,6 +59,8 @@ std::vector<V3> openingCentres(const HeightGrid& grid, const std::vector<V3>& fl
     return false;
   };
   for (const V3& fp : floor_points) {
+    if (static_cast<int>(out.size()) >= p.max_openings) break;
+    if (stop) stop->throwIfRequested();
     // The floor's height in the grid (its spheres' tops), the ray's hit for the point.
     const double h = gridHeightAt(grid, fp.x, fp.y);
     if (!std::isfinite(h)) continue;

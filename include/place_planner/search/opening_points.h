@@ -6,7 +6,7 @@
 // a little wider than the object gets a few of them, off its middle, and an object lowered
 // there lands on the rim (the YCB mustard over a 13 cm crock: 4 of 16 floor points inside, each
 // a few centimetres off the middle, no pose inside). From each floor point, the height grid is
-// walked out along kDirections horizontal directions to the first wall, a cell higher than the
+// walked out along kGridWalkDirections horizontal directions (height_grid_walk.h) to the first wall, a cell higher than the
 // floor point by `wall_height`, or to `reach`. Where walls stand in most directions the point
 // lies in an opening; it is moved to the mean of the walls' hits (for a round opening its
 // middle), a few times, and kept when the opening there is wide enough for the object's
@@ -27,10 +27,6 @@ struct OpeningParams {
   double min_enclosed = 0.75; // share of the directions that must meet a wall
   int max_openings = 64;      // bounded work: at most this many middles (each root there is fitted)
 };
-
-// The height grid's top at (x, y) (G): its highest sphere centre plus the collision distance;
-// -infinity (not finite) off the grid or over an empty cell.
-double gridHeightAt(const HeightGrid& grid, double x, double y);
 
 // The middles of the openings around `floor_points` (G), each at its floor's height, not
 // within `merge` of a floor point or of each other, in the order of the floor points they came from,

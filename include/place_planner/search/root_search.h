@@ -27,7 +27,8 @@ class RootSearch {
              std::vector<HangingStart> hanging = {});
   // The first floor points are the middles of openings (opening_points.h): their roots' start
   // orientations are turned about the vertical to fit the opening, their footprints' middles over
-  // its middle (fitIntoOpening).
+  // its middle (fitIntoOpening), each when its root is first posed (a search cut short fits only
+  // the roots it ran). `area` and `surface_O` must outlive the search.
   void fitOpenings(int opening_points, const AreaModel& area, const std::vector<V3>& surface_O);
   int size() const { return hangingCount() + static_cast<int>(floor_points_.size() * orientations_.size()); }
   int hangingCount() const { return static_cast<int>(hanging_.size()); }
@@ -40,6 +41,7 @@ class RootSearch {
   StartKind kind(int root) const;
   // The root's pose: centre of mass above the floor point along -d_vis, clear of everything
   // (V-A, first step), or threaded on its peg; and the translation to do, along direction().
+  // Not thread-safe: it fits an opening's root on first use.
   Rigid pose(int root) const;
   double tmax(int root) const;
   V3 direction(int root) const { return hanging(root) ? v3(0, 0, -1) : d_vis_; }
@@ -54,7 +56,11 @@ class RootSearch {
   double radius_;
   V3 d_vis_;
   double hmax_ = 0, hmin_ = 0;  // the area's extent along -d_vis
-  std::vector<OpeningFit> fit_;  // fitOpenings: per opening floor point and orientation
+  // fitOpenings: per opening floor point and orientation, fitted on first use (pose).
+  mutable std::vector<OpeningFit> fit_;
+  mutable std::vector<char> fitted_;
+  const HeightGrid* grid_ = nullptr;
+  const std::vector<V3>* surface_O_ = nullptr;
 };
 
 }  // namespace place_planner

@@ -5,10 +5,11 @@
 #include <cmath>
 #include <limits>
 
+#include "place_planner/model/height_grid_walk.h"
+
 namespace place_planner {
 namespace {
 
-constexpr int kDirections = 16;
 constexpr int kCentring = 4;  // moves to the walls' mean
 
 struct Walls {
@@ -17,42 +18,29 @@ struct Walls {
   double mx = 0, my = 0;        // the mean of the hits (a direction without one: its reach)
 };
 
-// Walks out from (x, y) at floor height h along kDirections directions, a cell at a time.
+// Walks out from (x, y) at floor height h round the point (height_grid_walk.h).
 Walls walls(const HeightGrid& g, double x, double y, double h, const OpeningParams& p) {
   Walls w;
-  const int steps = static_cast<int>(std::ceil(p.reach / g.cell));
-  for (int k = 0; k < kDirections; ++k) {
-    const double a = 2 * M_PI * k / kDirections, cx = std::cos(a), cy = std::sin(a);
-    double r = p.reach;
-    for (int s = 1; s <= steps; ++s) {
-      const double t = s * g.cell;
-      if (gridHeightAt(g, x + t * cx, y + t * cy) > h + p.wall_height) {
-        r = t;
-        ++w.hits;
-        break;
-      }
-    }
+  const double top = h + p.wall_height;
+  for (int k = 0; k < kGridWalkDirections; ++k) {
+    const GridStop wall = walkOut(g, x, y, k, p.reach, [top](double z) { return z > top; });
+    const double r = std::isfinite(wall.t) ? wall.t : p.reach;
+    w.hits += std::isfinite(wall.t);
+    const double a = 2 * M_PI * k / kGridWalkDirections;
     w.nearest = std::min(w.nearest, r);
-    w.mx += (x + r * cx) / kDirections;
-    w.my += (y + r * cy) / kDirections;
+    w.mx += (x + r * std::cos(a)) / kGridWalkDirections;
+    w.my += (y + r * std::sin(a)) / kGridWalkDirections;
   }
   return w;
 }
 
 }  // namespace
 
-double gridHeightAt(const HeightGrid& g, double x, double y) {
-  const int ix = static_cast<int>(std::floor((x - g.x0) / g.cell));
-  const int iy = static_cast<int>(std::floor((y - g.y0) / g.cell));
-  if (ix < 0 || iy < 0 || ix >= g.nx || iy >= g.ny) return -std::numeric_limits<double>::infinity();
-  return g.max_z[static_cast<size_t>(iy) * g.nx + ix];
-}
-
 std::vector<V3> openingCentres(const HeightGrid& grid, const std::vector<V3>& floor_points, const OpeningParams& p,
                                const StopSignal* stop) {
   std::vector<V3> out;
   if (grid.nx == 0 || grid.ny == 0 || p.reach <= 0) return out;
-  const int min_hits = static_cast<int>(std::ceil(p.min_enclosed * kDirections));
+  const int min_hits = static_cast<int>(std::ceil(p.min_enclosed * kGridWalkDirections));
   auto near = [&](const V3& c, const std::vector<V3>& pts) {
     for (const V3& q : pts)
       if (std::hypot(c.x - q.x, c.y - q.y) < p.merge && std::abs(c.z - q.z) < p.wall_height) return true;

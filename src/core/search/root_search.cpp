@@ -60,16 +60,19 @@ StartKind RootSearch::kind(int root) const {
 void RootSearch::fitOpenings(int opening_points, const AreaModel& area, const std::vector<V3>& surface_O) {
   const int n = std::min(opening_points, static_cast<int>(floor_points_.size()));
   fit_.assign(static_cast<size_t>(n) * orientations_.size(), OpeningFit{});
-  for (int f = 0; f < n; ++f)
-    for (size_t o = 0; o < orientations_.size(); ++o)
-      fit_[f * orientations_.size() + o] =
-          fitIntoOpening(area.grid, floor_points_[f], orientations_[o].R_GO, surface_O, toV3(com_O_));
+  fitted_.assign(fit_.size(), 0);
+  grid_ = &area.grid;
+  surface_O_ = &surface_O;
 }
 
 Rigid RootSearch::pose(int root) const {
   if (const HangingStart* h = hanging(root)) return h->X_GO;
   const size_t o = (root - hangingCount()) % orientations_.size();
   const size_t i = static_cast<size_t>(floorPoint(root)) * orientations_.size() + o;
+  if (i < fit_.size() && !fitted_[i]) {
+    fit_[i] = fitIntoOpening(*grid_, floor_points_[floorPoint(root)], orientations_[o].R_GO, *surface_O_, toV3(com_O_));
+    fitted_[i] = 1;
+  }
   const OpeningFit fit = i < fit_.size() ? fit_[i] : OpeningFit{};
   const Eigen::Matrix3d R = Eigen::AngleAxisd(fit.yaw, Eigen::Vector3d::UnitZ()) * orientations_[o].R_GO;
   const Eigen::Vector3d com_G = toEigen(floor_points_[floorPoint(root)]) - clearance(root) * toEigen(d_vis_) +

@@ -1,9 +1,11 @@
-// Openings of the area (search/opening_points.h) and drop-offs (judgement/drop_margin.h).
+// Openings of the area (search/opening_points.h), drop-offs (judgement/drop_margin.h) and the
+// height grid's walk both use (model/height_grid_walk.h).
 #include <Eigen/Geometry>
 #include <cmath>
 
 #include "place_planner/infra/mesh_io.h"
 #include "place_planner/judgement/drop_margin.h"
+#include "place_planner/model/height_grid_walk.h"
 #include "place_planner/model/scene.h"
 #include "place_planner/planner.h"
 #include "place_planner/search/opening_points.h"
@@ -36,6 +38,23 @@ Mesh tray() {
 }
 
 }  // namespace
+
+// From the cup's middle every direction meets its wall 6 cm out (within a cell and a sphere);
+// a walk that asks for nothing runs to its reach and stops nowhere; off the grid the height is
+// not finite.
+TEST(HeightGridWalk, EveryDirectionFromACupsMiddleMeetsItsWall) {
+  const AreaModel am = model(cup());
+  const double floor = gridHeightAt(am.grid, 0, 0);
+  ASSERT_TRUE(std::isfinite(floor));
+  for (int k = 0; k < kGridWalkDirections; ++k) {
+    const GridStop wall = walkOut(am.grid, 0, 0, k, 0.1, [&](double h) { return h > floor + 0.02; });
+    ASSERT_TRUE(std::isfinite(wall.t)) << "direction " << k;
+    EXPECT_NEAR(wall.t, 0.06, am.grid.cell + 2 * kR) << "direction " << k;
+    EXPECT_GT(wall.height, floor + 0.02);
+    EXPECT_FALSE(std::isfinite(walkOut(am.grid, 0, 0, k, 0.1, [](double) { return false; }).t));
+  }
+  EXPECT_FALSE(std::isfinite(gridHeightAt(am.grid, 5.0, 0.0)));
+}
 
 TEST(Openings, AFloorPointInACupMovesToItsMiddle) {
   const AreaModel am = model(cup());

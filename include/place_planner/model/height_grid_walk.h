@@ -8,8 +8,9 @@
 
 namespace place_planner {
 
-// Directions of a walk round a point: every 22.5 degrees.
+// Directions of a walk round a point: every 22.5 degrees; direction k's angle from +x (rad).
 constexpr int kGridWalkDirections = 16;
+inline double gridWalkAngle(int k) { return 2 * M_PI * k / kGridWalkDirections; }
 
 // The grid's top at (x, y) (G): its highest sphere centre plus the collision distance;
 // -infinity (not finite) off the grid or over an empty cell.
@@ -26,7 +27,7 @@ struct GridStop {
 // `stop` accepts.
 template <typename Stop>
 GridStop walkOut(const HeightGrid& grid, double x, double y, int k, double reach, const Stop& stop) {
-  const double a = 2 * M_PI * k / kGridWalkDirections, cx = std::cos(a), cy = std::sin(a);
+  const double a = gridWalkAngle(k), cx = std::cos(a), cy = std::sin(a);
   const int steps = static_cast<int>(std::ceil(reach / grid.cell));
   for (int s = 1; s <= steps; ++s) {
     const double t = s * grid.cell;

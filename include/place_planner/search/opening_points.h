@@ -6,11 +6,11 @@
 // a little wider than the object gets a few of them, off its middle, and an object lowered
 // there lands on the rim (the YCB mustard over a 13 cm crock: 4 of 16 floor points inside, each
 // a few centimetres off the middle, no pose inside). From each floor point, the height grid is
-// walked out along kGridWalkDirections horizontal directions (height_grid_walk.h) to the first wall, a cell higher than the
-// floor point by `wall_height`, or to `reach`. Where walls stand in most directions the point
-// lies in an opening; it is moved to the mean of the walls' hits (for a round opening its
-// middle), a few times, and kept when the opening there is wide enough for the object's
-// narrowest side.
+// walked out along kGridWalkDirections horizontal directions (height_grid_walk.h) to the first
+// wall, a cell higher than the floor point by `wall_height`, or to `reach`. Where walls stand in
+// most directions the point lies in an opening; it is moved to the mean of the walls' hits (for
+// a round opening its middle), a few times, and kept when the opening there is wide enough for
+// the object's narrowest side.
 #pragma once
 #include <Eigen/Core>
 #include <vector>

@@ -18,7 +18,7 @@ double dropMargin(const HeightGrid& grid, const Eigen::Vector3d& com_G, double s
       return !std::isfinite(h) || h > support_z + p.wall || h < support_z - p.drop;
     });
     const bool drop = std::isfinite(s.t) && std::isfinite(s.height) && s.height < support_z - p.drop;
-    sum += std::min(drop ? s.t : p.reach, p.reach) / p.reach;
+    sum += (drop ? std::min(s.t, p.reach) : p.reach) / p.reach;
   }
   return sum / kGridWalkDirections;
 }

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "place_planner/model/height_grid_walk.h"
 
@@ -26,7 +25,7 @@ Walls walls(const HeightGrid& g, double x, double y, double h, const OpeningPara
     const GridStop wall = walkOut(g, x, y, k, p.reach, [top](double z) { return z > top; });
     const double r = std::isfinite(wall.t) ? wall.t : p.reach;
     w.hits += std::isfinite(wall.t);
-    const double a = 2 * M_PI * k / kGridWalkDirections;
+    const double a = gridWalkAngle(k);
     w.nearest = std::min(w.nearest, r);
     w.mx += (x + r * std::cos(a)) / kGridWalkDirections;
     w.my += (y + r * std::sin(a)) / kGridWalkDirections;

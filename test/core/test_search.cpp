@@ -536,6 +536,36 @@ TEST(Stability, WedgeNeedsSqueezeAndIsNotStable) {
   EXPECT_TRUE(equilibrium(floor, Eigen::Vector3d(0, 0, 0.01), Eigen::Vector3d(0, 0, -1), 0.2));
 }
 
+// A line of contacts along a round body's side on a slope (the line level, across the fall
+// line): steeper than the friction angle it slides down the slope before any turn; on a slope
+// friction holds, the tree turns it about the line as before (no slide).
+TEST(Stability, ALineOnASlopeSteeperThanFrictionSlidesDownIt) {
+  auto lineOn = [](double slope_deg) {
+    const double a = slope_deg * M_PI / 180;
+    const Eigen::Vector3d n(0, -std::sin(a), std::cos(a));  // rising towards +y
+    std::vector<ContactPoint> c;
+    for (double x = -0.05; x <= 0.05 + 1e-9; x += 0.01) c.push_back({{x, 0, 0}, n, n});
+    return std::make_pair(c, Eigen::Vector3d(Eigen::Vector3d(0, 0, 0) + 0.03 * n));
+  };
+  const auto [steep, com_steep] = lineOn(35);
+  const Stability s = evaluateStability(steep, com_steep, StabilityParams{});
+  EXPECT_FALSE(s.stable);
+  EXPECT_TRUE(s.slips);
+  EXPECT_EQ(s.failure, Failure::kSlide);
+  // Down the slope, in its plane: towards -y and down, at right angles to the normal.
+  EXPECT_LT(s.d_f.y(), -0.5);
+  EXPECT_LT(s.d_f.z(), -0.5);
+  EXPECT_NEAR(s.d_f.dot(s.plane_normal), 0.0, 1e-9);
+  const auto [gentle, com_gentle] = lineOn(5);  // atan 0.2 = 11.3 degrees
+  const Stability g = evaluateStability(gentle, com_gentle, StabilityParams{});
+  EXPECT_FALSE(g.stable);
+  EXPECT_FALSE(g.slips);
+  // Two slopes facing each other (a trough) hold by friction and wedging: no slide down either.
+  auto both = steep;
+  for (const auto& p : steep) both.push_back({{p.p_W.x(), -0.05, 0}, {0, -p.n_W.y(), p.n_W.z()}, {0, -p.n_W.y(), p.n_W.z()}});
+  EXPECT_FALSE(evaluateStability(both, Eigen::Vector3d(0, -0.025, 0.03), StabilityParams{}).slips);
+}
+
 TEST(Stability, ContactsFromAboveNeverHold) {
   // The cube under a table top: contacts on its top face, normals pointing down at it.
   std::vector<ContactPoint> c;

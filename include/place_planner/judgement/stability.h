@@ -32,6 +32,10 @@ struct Stability {
   // Only friction fails (slipDirection, contact_forces.h): d_f is the horizontal slip. The tree
   // slides it before any turn: a marker's foot in a cup, a plate's on a rack's floor.
   bool slips = false;
+  // ... down a surface steeper than the friction angle, on a line of contacts (d_f in the
+  // surface, not horizontal): the tree slides it at most its own size at a time, and on past
+  // where the surface ends (it falls from there), not only up to a contact.
+  bool slips_downhill = false;
   // Every contact lies above the centre of mass: the object hangs (a ring on a peg, a mug by
   // its handle). Stable when the forces balance gravity and friction holds gravity tilted by
   // half the friction angle; a tilt's torque is taken by a swing (the tree's swing settle).

@@ -329,6 +329,50 @@ bool balancedWithMargin(const std::vector<ContactPoint>& contacts, const Eigen::
   return true;
 }
 
+// A line of contacts (longer than the contact tolerance: a body's side, not a point on an
+// edge) where the object's surface lies on one flat surface of the area (each contact's normal,
+// the two meshes' blend, within kFaceOnFace of the area's own there, and those within
+// kOneSurface of their mean: face on face on one plane, not an edge on an edge nor across a
+// curved surface's facets), steeper than the friction angle and at most kSteepestSlope:
+// nothing there holds it (the planar case's angle(P, -d_g) < atan mu fails for any plane the
+// contacts lie on), and it slides down that surface before it turns. A round body on a ramp
+// steeper than atan mu rolls and slides down to what stops it (a trough's other side), where
+// tilts about its line of contact would turn it by fractions of a degree at a time along its
+// curved side. False (r unchanged) otherwise.
+constexpr double kOneSurface = 3 * M_PI / 180;
+constexpr double kFaceOnFace = 20 * M_PI / 180;
+// Steeper than this the surface is a wall, not a slope (a bin's flared sides, a tray's drafted
+// walls): what touches it there leans or falls, and the tree turns it as before. (Up to 90
+// degrees: on the rack and tray scans one best pose fewer kept, on the shared scans a marker
+// stood in a bin's corner.)
+constexpr double kSteepestSlope = 45 * M_PI / 180;
+bool slidesDownSteepSurface(Stability& r, const std::vector<ContactPoint>& contacts, double cone, double tol) {
+  Eigen::Vector3d mid = Eigen::Vector3d::Zero(), m = Eigen::Vector3d::Zero();
+  for (const auto& p : contacts) {
+    if (p.n_area_W.squaredNorm() == 0 || p.n_W.dot(p.n_area_W) < std::cos(kFaceOnFace)) return false;
+    mid += p.p_W;
+    m += p.n_area_W;
+  }
+  mid /= static_cast<double>(contacts.size());
+  double reach = 0;
+  for (const auto& p : contacts) reach = std::max(reach, (p.p_W - mid).norm());
+  if (reach <= tol) return false;  // within tol of one point (ContactLayout::kSingle)
+  if (m.norm() < 1e-9 || m.dot(kUp) <= 0) return false;
+  m.normalize();
+  const double slope = std::acos(std::clamp(m.dot(kUp), -1.0, 1.0));
+  if (slope <= cone || slope > kSteepestSlope) return false;
+  for (const auto& p : contacts)
+    if (p.n_area_W.dot(m) < std::cos(kOneSurface)) return false;
+  r.friction_ok = false;
+  r.failure = Failure::kSlide;
+  r.slips = true;
+  r.slips_downhill = true;
+  r.plane_normal = m;
+  r.d_f = (-kUp - (-kUp).dot(m) * m).normalized();  // d_g projected onto the surface
+  r.pivot = farthest(contacts, r.d_f);
+  return true;
+}
+
 }  // namespace
 
 Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eigen::Vector3d& com,
@@ -382,7 +426,10 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
     r.planar = true;
     r.plane_normal = n;
     const Support s = analyse(pts, c, n, com);
-    if (!s.valid) return r;  // collinear: the tree rotates further
+    if (!s.valid) {  // collinear: the tree rotates further, unless it slides first
+      slidesDownSteepSurface(r, contacts, cone, prm.tol);
+      return r;
+    }
     r.hull = s.hull3;
     r.quality = s.quality;
     r.tipping_angle = s.tip;
@@ -456,7 +503,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
   if (stable) {
     r.failure = Failure::kNone;
     r.quality = std::max(r.quality, 0.3);  // Q is a ranking here; equilibrium decided stability
-  } else if (!slides(r, slip)) {
+  } else if (!slides(r, slip) && (r.balanced || !slidesDownSteepSurface(r, contacts, cone, prm.tol))) {
     r.failure = Failure::kTip;
     r.d_f = ref.valid ? tipDirection(ref) : Eigen::Vector3d::UnitX();
     if (ref.valid) tipEdge(ref, &r.tip_edge_point, &r.tip_edge_dir);

@@ -203,12 +203,14 @@ void TreeStepper::step(std::vector<TreeLeaf>& leaves) {
 void TreeStepper::firstContactStep() {
   const auto t0 = Clock::now();
   std::vector<TranslationQuery> q;
-  for (const TreeNode& n : translate_) q.push_back({n.X_GO, n.pending.front(), n.pending_tmax.front()});
+  // A negative reach: the move goes that far when nothing is hit on the way.
+  for (const TreeNode& n : translate_) q.push_back({n.X_GO, n.pending.front(), std::abs(n.pending_tmax.front())});
   std::vector<double> t;
   ctx_.backend.distance(q, t);
   std::vector<TreeNode> again;
   for (size_t i = 0; i < translate_.size(); ++i) {
     TreeNode& n = translate_[i];
+    if (t[i] >= kInf && n.pending_tmax.front() < 0) t[i] = -n.pending_tmax.front();
     if (t[i] >= kInf) continue;  // nothing below: the object would fall off the area
     n.X_GO = translated(n.X_GO, t[i] * n.pending.front());
     n.path.push_back(n.X_GO);
@@ -308,14 +310,19 @@ void TreeStepper::contactStep(std::vector<TreeLeaf>& leaves) {
     // Local optimisation (Section VI): slide down the slope, or tip into the failure direction.
     auto optimise = [&] {
       const auto tl = Clock::now();
-      const LocalStep step = localOptimisationStep(s, com, cd);
+      // A slide down a steep surface lifts the object clear of it by half the last lift: between
+      // two surfaces that each slide it onto the other (a trough's sides) it settles into
+      // contact with both within a few slides, instead of bouncing by the same lift forever.
+      const LocalStep step = localOptimisationStep(s, com, s.slips_downhill ? std::ldexp(cd, -std::min(n.opt, 8)) : cd);
       addTime(ctx_.times ? &ctx_.times->local_optimisation : nullptr, tl);
       if (step.kind == LocalStep::kSlide) {
         ++n.opt;
         n.X_GO = translated(n.X_GO, toV3(step.lift));
         n.path.push_back(n.X_GO);
         n.pending = {toV3(step.slide), v3(0, 0, -1)};
-        n.pending_tmax = {0.5 * diag_, diag_};
+        // Down a steep surface: at most the object's size, and that far when nothing is hit
+        // (a negative reach, firstContactStep); the drop then finds where it lands.
+        n.pending_tmax = {s.slips_downhill ? -ctx_.om.bounding_radius : 0.5 * diag_, diag_};
         translate_.push_back(std::move(n));
       } else if (step.kind == LocalStep::kRotate) {
         ++n.opt;

@@ -41,7 +41,7 @@ struct TreeNode {
   V3 com_O{0, 0, 0};  // centre of mass used for stability, frame O (perturbed in trials)
   std::vector<Rigid> path;      // X_GO after each translation or rotation
   std::vector<V3> pending;      // translations still to do: directions (G) ...
-  std::vector<double> pending_tmax;  // ... and their search limits (m)
+  std::vector<double> pending_tmax;  // ... and their search limits (m); negative: go that far when nothing is hit
   // Rotation request (Section V-C): axis through s_A along d_A (G).
   Eigen::Vector3d s_A = Eigen::Vector3d::Zero(), d_A = Eigen::Vector3d::UnitX();
   bool both_directions = true;

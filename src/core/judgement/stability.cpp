@@ -18,6 +18,9 @@ constexpr double kSideContact = 0.3;
 const Eigen::Vector3d kUp = Eigen::Vector3d::UnitZ();  // -d_g in G
 
 
+// d_g projected onto the plane with unit normal n (not vertical), unit: the way down its slope.
+Eigen::Vector3d downSlope(const Eigen::Vector3d& n) { return (-kUp - (-kUp).dot(n) * n).normalized(); }
+
 // 2D analysis of a support polygon in the plane through `origin` with normal `n` (unit),
 // centre of mass projected along gravity (-z).
 struct Support {
@@ -368,7 +371,7 @@ bool slidesDownSteepSurface(Stability& r, const std::vector<ContactPoint>& conta
   r.slips = true;
   r.slips_downhill = true;
   r.plane_normal = m;
-  r.d_f = (-kUp - (-kUp).dot(m) * m).normalized();  // d_g projected onto the surface
+  r.d_f = downSlope(m);
   r.pivot = farthest(contacts, r.d_f);
   return true;
 }
@@ -455,8 +458,7 @@ Stability evaluateStability(const std::vector<ContactPoint>& contacts, const Eig
       // slides along slip
     } else if (!r.friction_ok) {
       r.failure = Failure::kSlide;
-      const Eigen::Vector3d down = -kUp - (-kUp).dot(n) * n;  // d_g projected onto P
-      r.d_f = down.normalized();
+      r.d_f = downSlope(n);
     } else {
       r.failure = Failure::kTip;
       r.d_f = tipDirection(s);
